@@ -1,0 +1,78 @@
+// lumx/io/photometry_io.h — reading and writing IES LM-63 and EULUMDAT files.
+//
+// The format layer on top of the model in lumx/photometry.h. Each format has a reader and a writer
+// (src/io/ies_reader.cpp, ies_writer.cpp, ldt_reader.cpp, ldt_writer.cpp); read_photometry() picks one by
+// file extension and falls back to sniffing the content. Readers are permissive about what real files do
+// (formats.md §1.6, §2.4) and report it as warnings; they throw lumx::Error, located by file, line and
+// field, for anything that would make the data wrong. Untrusted counts are checked against the values
+// actually present before anything is allocated from them.
+#pragma once
+
+#include <lumx/diagnostic.h>
+#include <lumx/photometry.h>
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+LUMX_NAMESPACE_BEGIN
+
+enum class PhotometryFormat { ies, ldt };
+
+/// Limits that protect readers from absurd or hostile files. A file exceeding one is rejected.
+struct ReadLimits {
+  std::size_t max_file_bytes = 64u << 20;  ///< 64 MiB: the largest real IES file is ~2 MB
+  std::size_t max_angles = 3601;           ///< per axis (0.05 degree steps over 180 degrees)
+  std::size_t max_lamp_sets = 20;          ///< EULUMDAT allows at most 20 lamp sets
+};
+
+struct ReadOptions {
+  DiagnosticSink warnings;  ///< receives warnings and notes; may be empty
+  ReadLimits limits;
+  /// Folder in which an IES `TILT=<file>` is looked up. read_photometry(path) sets it to the file's
+  /// folder; reading from memory without it makes an external TILT file an error.
+  std::string base_dir;
+};
+
+/// Parses IES LM-63 text (1986, 1991, 1995, 2002, 2019). `name` is used in diagnostics.
+Photometry read_ies(std::string_view text, const std::string& name, const ReadOptions& options = {});
+/// Parses EULUMDAT text. `name` is used in diagnostics.
+Photometry read_ldt(std::string_view text, const std::string& name, const ReadOptions& options = {});
+
+/// Format from a file name's extension (.ies, .ldt, case-insensitive), else by sniffing `head` (the
+/// file's first bytes): an IES version line or a TILT= line means IES, otherwise EULUMDAT if the first
+/// lines have its numeric layout. Throws lumx::Error if neither fits.
+PhotometryFormat detect_format(const std::string& path, std::string_view head);
+
+/// Reads a file of either format. Throws lumx::Error (file missing, too large, or malformed).
+Photometry read_photometry(const std::string& path, const ReadOptions& options = {});
+
+/// LM-63 editions the IES writer can produce.
+enum class IesVersion { lm63_2002, lm63_2019 };
+
+struct IesWriteOptions {
+  IesVersion version = IesVersion::lm63_2019;
+  int significant_digits = 7;  ///< candela and angle precision
+};
+
+struct LdtWriteOptions {
+  int significant_digits = 7;
+};
+
+/// IES text for `p` (Type A, B or C). The stored subset is written with the range that states its
+/// symmetry; candela are written as absolute cd with multiplier 1. Throws lumx::Error if `p` cannot be
+/// expressed (e.g. inconsistent table sizes).
+std::string format_ies(const Photometry& p, const IesWriteOptions& options = {});
+/// EULUMDAT text for `p`. Type C only (convert A/B with to_type_c first); intensities written in cd/klm.
+std::string format_ldt(const Photometry& p, const LdtWriteOptions& options = {});
+
+struct WriteOptions {
+  IesWriteOptions ies;
+  LdtWriteOptions ldt;
+};
+
+/// Writes `p` in the format named by `path`'s extension, atomically (temporary file in the same folder,
+/// fsync, rename): on any failure the previous file, if any, is left untouched.
+void write_photometry(const Photometry& p, const std::string& path, const WriteOptions& options = {});
+
+LUMX_NAMESPACE_END

@@ -1,0 +1,106 @@
+#include "io/text_scanner.h"
+
+#include <charconv>
+#include <cmath>
+
+LUMX_NAMESPACE_BEGIN
+namespace detail {
+
+std::vector<Line> split_lines(std::string_view text) {
+  if (text.size() >= 3 && static_cast<unsigned char>(text[0]) == 0xEF &&
+      static_cast<unsigned char>(text[1]) == 0xBB && static_cast<unsigned char>(text[2]) == 0xBF)
+    text.remove_prefix(3);
+  std::vector<Line> lines;
+  std::size_t start = 0;
+  int number = 1;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n' || c == '\r') {
+      lines.push_back({text.substr(start, i - start), number++});
+      if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
+      start = i + 1;
+    }
+  }
+  if (start < text.size()) lines.push_back({text.substr(start), number});
+  return lines;
+}
+
+std::string_view trim(std::string_view s) {
+  auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\0' || c == '\f' || c == '\v'; };
+  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+namespace {
+bool valid_utf8(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    if (c < 0x80) n = 0;
+    else if ((c >> 5) == 0x6) n = 1;
+    else if ((c >> 4) == 0xE) n = 2;
+    else if ((c >> 3) == 0x1E) n = 3;
+    else return false;
+    if (n > 0 && i + n >= s.size()) return false;  // sequence cut off by the end
+    for (std::size_t k = 1; k <= n; ++k)
+      if ((static_cast<unsigned char>(s[i + k]) >> 6) != 0x2) return false;
+    i += n + 1;
+  }
+  return true;
+}
+}  // namespace
+
+std::string to_utf8(std::string_view s) {
+  if (valid_utf8(s)) return std::string(s);
+  std::string out;
+  out.reserve(s.size() + s.size() / 4);
+  for (char ch : s) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c < 0x80) {
+      out.push_back(ch);
+    } else {
+      out.push_back(static_cast<char>(0xC0 | (c >> 6)));
+      out.push_back(static_cast<char>(0x80 | (c & 0x3F)));
+    }
+  }
+  return out;
+}
+
+bool parse_number(std::string_view token, double& out) {
+  if (token.empty()) return false;
+  if (token.front() == '+') token.remove_prefix(1);
+  if (token.empty()) return false;
+  // from_chars would accept "nan", "inf" and hex-free forms only; refuse anything not starting like a number.
+  const char c0 = token.front();
+  if (!(c0 == '-' || c0 == '.' || (c0 >= '0' && c0 <= '9'))) return false;
+  double v = 0;
+  const auto r = std::from_chars(token.data(), token.data() + token.size(), v, std::chars_format::general);
+  if (r.ec != std::errc() || r.ptr != token.data() + token.size()) return false;
+  if (!std::isfinite(v)) return false;
+  out = v;
+  return true;
+}
+
+std::vector<Token> tokenize(const std::vector<Line>& lines, std::size_t first_line) {
+  std::vector<Token> tokens;
+  for (std::size_t li = first_line; li < lines.size(); ++li) {
+    const std::string_view s = lines[li].text;
+    std::size_t i = 0;
+    while (i < s.size()) {
+      while (i < s.size() && (s[i] == ' ' || s[i] == '\t' || s[i] == ',' || s[i] == '\0' || s[i] == '\f' ||
+                              s[i] == '\v'))
+        ++i;
+      const std::size_t b = i;
+      while (i < s.size() && !(s[i] == ' ' || s[i] == '\t' || s[i] == ',' || s[i] == '\0' || s[i] == '\f' ||
+                               s[i] == '\v'))
+        ++i;
+      if (i > b) tokens.push_back({s.substr(b, i - b), lines[li].number});
+    }
+  }
+  return tokens;
+}
+
+}  // namespace detail
+LUMX_NAMESPACE_END

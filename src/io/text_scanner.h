@@ -1,0 +1,45 @@
+// Internal: line splitting, tokenising and strict number parsing shared by the text-format readers.
+#pragma once
+
+#include <lumx/diagnostic.h>
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+LUMX_NAMESPACE_BEGIN
+namespace detail {
+
+/// One physical line (without its terminator) and its 1-based number.
+struct Line {
+  std::string_view text;
+  int number = 0;
+};
+
+/// Splits on CRLF, LF or lone CR. A UTF-8 byte-order mark at the start is dropped. A final line
+/// without a terminator is kept; trailing empty lines are kept too (callers skip them).
+std::vector<Line> split_lines(std::string_view text);
+
+/// Strips leading and trailing blanks (space, tab, and stray NUL / form feed).
+std::string_view trim(std::string_view s);
+
+/// Text as UTF-8: returned unchanged if it is valid UTF-8, else decoded as ISO-8859-1 (Latin-1), the
+/// other encoding real IES files use (formats.md §1.6).
+std::string to_utf8(std::string_view s);
+
+/// Strict decimal number: optional sign, digits with optional '.', optional exponent; the whole token
+/// must be consumed; NaN and infinities are refused. Accepts ".5" and "5.".
+bool parse_number(std::string_view token, double& out);
+
+/// A token of a numeric stream with the line it came from.
+struct Token {
+  std::string_view text;
+  int line = 0;
+};
+
+/// Splits lines into tokens separated by blanks, tabs or commas (LM-63-2002 delimiters).
+std::vector<Token> tokenize(const std::vector<Line>& lines, std::size_t first_line);
+
+}  // namespace detail
+LUMX_NAMESPACE_END
