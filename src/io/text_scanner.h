@@ -32,6 +32,10 @@ std::string to_utf8(std::string_view s);
 /// must be consumed; NaN and infinities are refused. Accepts ".5" and "5.".
 bool parse_number(std::string_view token, double& out);
 
+/// Shortest decimal text with at most `significant_digits` significant digits ("12.5", "1000", "0.001"),
+/// locale-independent, never "-0". Used by the writers.
+std::string format_number(double v, int significant_digits);
+
 /// A token of a numeric stream with the line it came from.
 struct Token {
   std::string_view text;
