@@ -1,0 +1,93 @@
+// lumx — command-line tool for luminaire data: info, check, convert, plot.
+//
+// Subcommands and their one-line help come from one table (kCommands); CLI11 renders `lumx --help`,
+// `lumx <cmd> --help` and usage errors (to stderr, exit status 2 or CLI11's code) from it.
+#include "commands.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <functional>
+
+namespace {
+
+struct Command {
+  const char* name;
+  const char* summary;
+  std::function<void(CLI::App&, int& status)> setup;  // adds options and the callback
+};
+
+int g_status = 0;
+lumx_cli::InfoArgs g_info;
+lumx_cli::CheckArgs g_check;
+lumx_cli::ConvertArgs g_convert;
+lumx_cli::PlotArgs g_plot;
+
+const Command kCommands[] = {
+    {"info", "Summarise a photometry file (IES or EULUMDAT): format, grid, flux, peak, beam/field angles",
+     [](CLI::App& c, int& st) {
+       c.add_option("file", g_info.file, "IES (.ies) or EULUMDAT (.ldt) file")->required();
+       c.add_flag("--json", g_info.json, "print the facts as JSON");
+       c.callback([&st] { st = lumx_cli::run_info(g_info); });
+     }},
+    {"check", "Validate files strictly: 'FILE: OK' or located findings; exit status 1 on errors",
+     [](CLI::App& c, int& st) {
+       c.add_option("files", g_check.files, "files to check")->required();
+       c.add_flag("--json", g_check.json, "print findings as JSON");
+       c.add_flag("--strict", g_check.strict, "treat warnings as failures");
+       c.callback([&st] { st = lumx_cli::run_check(g_check); });
+     }},
+    {"convert", "Convert between IES and EULUMDAT (format from the extensions)",
+     [](CLI::App& c, int& st) {
+       c.add_option("input", g_convert.in, "input file")->required();
+       c.add_option("output", g_convert.out, "output file (.ies or .ldt)")->required();
+       c.add_option("--ies-version", g_convert.ies_version, "LM-63 edition to write: 2019 (default) or 2002")
+           ->check(CLI::IsMember({"2002", "2019"}));
+       c.add_option("--rotate-c", g_convert.rotate_c_deg,
+                    "rotate C-planes by DEG (default 0; 90 or -90 switches between the 'C0 along' and "
+                    "'C0 across the luminaire length' readings)");
+       c.add_option("--digits", g_convert.digits, "significant digits written (default 7)")
+           ->check(CLI::Range(3, 17));
+       c.add_option("--apply-tilt", g_convert.tilt_deg,
+                    "fold the TILT multiplier at this installed tilt (degrees) into the candela values")
+           ->each([](const std::string&) { g_convert.apply_tilt = true; });
+       c.callback([&st] { st = lumx_cli::run_convert(g_convert); });
+     }},
+    {"plot", "Draw the polar intensity diagram (C0-C180 and C90-C270) as SVG or PNG",
+     [](CLI::App& c, int& st) {
+       c.add_option("file", g_plot.file, "IES or EULUMDAT file")->required();
+       c.add_option("-o,--output", g_plot.out, "output .svg or .png")->required();
+       c.add_option("--title", g_plot.title, "title (default: luminaire name or file name)");
+       c.add_option("--size", g_plot.size_px, "image size in pixels (default 800)")->check(CLI::Range(200, 8000));
+       c.add_flag("--cd", g_plot.force_cd, "plot absolute cd even for relative photometry (default cd/klm)");
+       c.callback([&st] { st = lumx_cli::run_plot(g_plot); });
+     }},
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"lumx — luminaire data interchange: read, check, convert and plot IES LM-63 and EULUMDAT files",
+               "lumx"};
+  app.require_subcommand(0, 1);
+  bool version = false;
+  app.add_flag("--version", version, "print library and file-format versions");
+  for (const Command& cmd : kCommands) {
+    CLI::App* sub = app.add_subcommand(cmd.name, cmd.summary);
+    cmd.setup(*sub, g_status);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);  // --help to stdout with 0; usage errors to stderr, non-zero
+  }
+  if (version) {
+    lumx_cli::print_version();
+    return 0;
+  }
+  if (app.get_subcommands().empty()) {
+    std::fputs(app.help().c_str(), stderr);
+    return 2;
+  }
+  return g_status;
+}

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Builds lumx (installing missing Debian packages first). Usage: scripts/build.sh [--sanitize]
+#   default      -> build/        (RelWithDebInfo, warnings as errors)
+#   --sanitize   -> build-asan/   (Debug, AddressSanitizer + UndefinedBehaviorSanitizer)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/deps.sh
+dir=build; extra=(-DCMAKE_BUILD_TYPE=RelWithDebInfo)
+if [ "${1:-}" = "--sanitize" ]; then
+  dir=build-asan; extra=(-DCMAKE_BUILD_TYPE=Debug -DLUMX_SANITIZE=ON -DLUMX_BUILD_BENCH=OFF)
+fi
+cmake -S . -B "$dir" -G Ninja "${extra[@]}" >/dev/null
+cmake --build "$dir" -j "$(nproc)"
+echo "$dir"
