@@ -3,6 +3,7 @@
 #include <lumx/resample.h>
 #include <lumx/symmetry.h>
 
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 using namespace lumx;
