@@ -19,8 +19,8 @@ namespace {
 [[noreturn]] void fail(const std::string& path, const std::string& step, int err) {
   Diagnostic d;
   d.file = path;
-  d.field = step;
-  d.message = std::strerror(err);
+  d.field = "file";
+  d.message = step + ": " + std::strerror(err);
   throw Error(std::move(d));
 }
 
@@ -72,7 +72,7 @@ void write_file_atomically(const std::string& path, std::string_view bytes) {
 
 std::string read_file_bounded(const std::string& path, std::size_t max_bytes) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) fail(path, "open", ENOENT);
+  if (!std::filesystem::is_regular_file(path, ec)) fail(path, "cannot open", ENOENT);
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) fail(path, "size", ec.value());
   if (size > max_bytes) {
@@ -83,7 +83,7 @@ std::string read_file_bounded(const std::string& path, std::size_t max_bytes) {
     throw Error(std::move(d));
   }
   std::ifstream f(path, std::ios::binary);
-  if (!f) fail(path, "open", errno ? errno : EACCES);
+  if (!f) fail(path, "cannot open", errno ? errno : EACCES);
   std::string s(static_cast<std::size_t>(size), '\0');
   f.read(s.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::size_t>(f.gcount()) != size) fail(path, "read", EIO);
