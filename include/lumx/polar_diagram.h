@@ -14,7 +14,7 @@
 //
 // Values are in the diagram's unit: cd/klm for relative photometry (!p.absolute and a rated lamp flux > 0;
 // value = cd * 1000 / rated lamp flux), otherwise cd. The rings are a "nice" step (1, 2, 2.5 or 5 times a
-// power of ten) chosen so that 4 to 6 rings cover the larger of the two curves' maxima.
+// power of ten) chosen so that 4 to 6 rings cover the larger of the two curves' maxima plus 2 % headroom.
 #pragma once
 
 #include <lumx/diagnostic.h>
@@ -66,7 +66,7 @@ struct PolarDiagram {
   bool relative = false;     ///< true if values are cd/klm
   std::string unit = "cd";   ///< "cd/klm" or "cd"
   double scale = 1;          ///< unit value = cd * scale (1000 / rated lamp flux for cd/klm, else 1)
-  PolarRingScale rings;      ///< covers max(c0_c180.max_value, c90_c270.max_value)
+  PolarRingScale rings;      ///< covers 1.02 * max(c0_c180.max_value, c90_c270.max_value)
 
   std::string title;         ///< luminaire name, else catalogue number, else the source file's name
   std::string file_name;     ///< the source file's name without folders (may be empty)
@@ -76,6 +76,9 @@ struct PolarDiagram {
   double max_horizontal_deg = 0;  ///< where that maximum is stored (C or H)
   double max_vertical_deg = 0;    ///< (gamma or V)
 };
+
+/// make_polar_diagram() sizes the rings for this multiple of the curves' maximum.
+inline constexpr double kPolarRingHeadroom = 1.02;
 
 /// Ring step and count for a curve maximum `max_value` (any unit): the smallest step m * 10^k,
 /// m in {1, 2, 2.5, 5}, with ceil(max_value / step) <= 6 rings. Consecutive candidates differ by at most a
@@ -91,13 +94,15 @@ inline PolarRingScale nice_ring_scale(double max_value) {
     const double p10 = std::pow(10.0, k);
     for (double m : kMantissas) {
       const double step = m * p10;
-      // Tolerate rounding so that max_value == 5 * step counts 5 rings, not 6.
-      const double n = std::ceil(max_value / step * (1 - 1e-12));
+      // The fewest rings n with n * step >= max_value, checked on the products actually used, so that
+      // a maximum of exactly 5 * step gives 5 rings (not 6 through rounding of the quotient).
+      double n = std::max(1.0, std::ceil(max_value / step));
+      while (n > 1 && (n - 1) * step >= max_value) n -= 1;
+      while (n * step < max_value) n += 1;
       if (n <= 6) {
         s.ring_step = step;
-        s.ring_count = std::max(1, static_cast<int>(n));
-        s.outer_radius = s.ring_count * step;
-        if (s.outer_radius < max_value) s.outer_radius = max_value;  // unreachable but cheap
+        s.ring_count = static_cast<int>(n);
+        s.outer_radius = n * step;
         return s;
       }
     }
@@ -174,7 +179,8 @@ inline PolarDiagram make_polar_diagram(const Photometry& p, const PolarDiagramOp
     d.message = message;
     throw Error(std::move(d));
   };
-  if (!(options.step_deg > 0) || options.step_deg > 180) fail("step", "polar sampling step must be in (0, 180] degrees");
+  if (!(options.step_deg > 0) || options.step_deg > 180)
+    fail("step", "polar sampling step must be in (0, 180] degrees");
 
   PolarDiagram dg;
   dg.rated_lamp_flux_lm = p.rated_lamp_flux_lm();
@@ -234,7 +240,9 @@ inline PolarDiagram make_polar_diagram(const Photometry& p, const PolarDiagramOp
 
   for (PolarCurve* c : {&dg.c0_c180, &dg.c90_c270})
     for (const PolarPoint& pt : c->points) c->max_value = std::max(c->max_value, pt.value);
-  dg.rings = nice_ring_scale(std::max(dg.c0_c180.max_value, dg.c90_c270.max_value));
+  // 2 % headroom, so that a curve whose maximum is just below a nice value does not run along the outer
+  // ring (an isotropic 1000 lm source peaks at 79.6 cd/klm: five rings of 20, not four).
+  dg.rings = nice_ring_scale(kPolarRingHeadroom * std::max(dg.c0_c180.max_value, dg.c90_c270.max_value));
   return dg;
 }
 
