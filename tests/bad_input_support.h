@@ -217,4 +217,36 @@ inline void never_crash_sweep(const std::function<lumx::Photometry(const std::st
     if (!loads_sanely_or_errors(read, muts[k], name + " mutation #" + std::to_string(k))) ++failures;
 }
 
+/// Every numeric token of `good` (a maximal run of digits, '.', '+', '-', 'e', 'E' that holds a digit)
+/// replaced in turn by each hostile token: catches what random corruption rarely hits, such as a
+/// candela multiplier of 1e308 that overflows the table to inf.
+inline void token_sweep(const std::function<lumx::Photometry(const std::string&)>& read, const std::string& good,
+                        const std::string& name) {
+  static const char* const kTokens[] = {"2147483647", "-2147483648", "-1", "0", "1e308", "-1e308", "1e-320",
+                                        "nan", "inf", "4294967297", "1.5", "99999", "1,5", ""};
+  auto numch = [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == '+' || c == '-' || c == 'e' || c == 'E';
+  };
+  int failures = 0;
+  for (std::size_t b = 0; b < good.size() && failures < 10;) {
+    if (!numch(good[b])) {
+      ++b;
+      continue;
+    }
+    std::size_t e = b;
+    bool digit = false;
+    for (; e < good.size() && numch(good[e]); ++e)
+      if (std::isdigit(static_cast<unsigned char>(good[e]))) digit = true;
+    if (digit)
+      for (const char* t : kTokens) {
+        std::string s = good;
+        s.replace(b, e - b, t);
+        if (!loads_sanely_or_errors(read, s, name + ": '" + good.substr(b, e - b) + "' at byte " + std::to_string(b) +
+                                                   " -> '" + t + "'"))
+          ++failures;
+      }
+    b = e;
+  }
+}
+
 }  // namespace lumx_bad

@@ -88,6 +88,11 @@ write("ies_candela_negative_noise.ies", ies(cd=BASE_CD[:2] + ["500 300 100 -0.25
 # -50 with a peak of 500 -> E.
 write("ies_candela_negative_large.ies", ies(cd=BASE_CD[:2] + ["500 300 100 -50"] + BASE_CD[3:]))
 
+# A product that overflows: value x multiplier = inf must be refused like a literal inf.
+write("ies_multiplier_overflow.ies", ies(numbers_line1="1 1000 1e308 4 5 1 2 0.5 0.6 0"))
+write("ies_candela_overflow.ies", ies(numbers_line1="1 1000 10 4 5 1 2 0.5 0.6 0",
+                                      cd=BASE_CD[:2] + ["500 300 1e308 0"] + BASE_CD[3:]))
+
 # Item 5: absolute photometry (lumens = -1), analytic flux.
 iso_v = "0 10 30 45 60 90 120 150 170 180"  # deliberately non-uniform
 write("ies_lumens_absolute_isotropic.ies",
@@ -160,6 +165,14 @@ write("ies_1986_no_version.ies",
       ies(header="REPORT NUMBER: 1234\nLUMINAIRE: TEST DOWNLIGHT\nLAMP: 1 X 1000 LM\n"))
 write("ies_long_label.ies",
       ies(header="IESNA:LM-63-1995\n[TEST] " + "X" * 120 + "\n[MANUFAC] lumx\n"))
+# Real-world header quirks (formats.md 1.6): keyword text containing "TILT=", a version line with a
+# blank, and a 2019 file whose file-generation type 1.10000 must not scale the candela (ballast 0.9 is
+# reported, not applied either).
+write("ies_keyword_mentions_tilt.ies",
+      ies(header=HEADER_2002 + "[OTHER] see TILT=INCLUDE note\n[LAMP] LED TILT=30\n"))
+write("ies_version_with_space.ies", ies(header=HEADER_2002.replace("IESNA:LM", "IESNA: LM")))
+write("ies_2019_filegen_type.ies", ies(header=HEADER_2002.replace("IESNA:LM-63-2002", "IES:LM-63-2019"),
+                                       line2="0.9 1.10000 25"))
 # Numbers wrapped at arbitrary points, leading blanks, ".5", one number per line, trailing blank lines.
 write("ies_wrapped_values.ies",
       HEADER_2002 + "TILT=NONE\n1\n1000 1\n4 5 1 2 .5\n0.6 0 1\n1 25 0 30\n 60 90 0\n90\n180 270 360 500 400\n"
@@ -229,6 +242,8 @@ write("ldt_isym2_mc_odd.ldt", ldt(isym=2, mc=7, dc=0, c_angles=["0", "50", "100"
                                   intensities=ISYM4_CD + ["300", "150", "75", "25", "10"]))
 write("ldt_isym3_mc_odd.ldt", ldt(isym=3, mc=7, dc=0, c_angles=["0", "50", "100", "150", "200", "250", "300"],
                                   intensities=ISYM4_CD + ["300", "150", "75", "25", "10"]))
+# Mc = 6 is even, but Isym 3 stores C270..C90 and Mc = 6 has neither a C90 nor a C270 plane.
+write("ldt_isym3_mc_not_multiple_of_4.ldt", ldt(isym=3, mc=6, dc=60, intensities=ISYM4_CD + ["300", "150", "75", "25", "10"]))
 write("ldt_isym4_mc_not_multiple.ldt", ldt(isym=4, mc=6, dc=60, intensities=ISYM4_CD))
 
 # Item 12: Nc > 721, Ng > 361, spacing <= 0, lamp sets > 20 or <= 0.
@@ -268,6 +283,15 @@ write("ldt_lamp_count_fraction.ldt", ldt(lamps=[("1.5", "LED", "1000", "3000K", 
                                          intensities=ISYM4_CD))
 write("ldt_intensity_nan.ldt", ldt(intensities=ISYM4_CD[:6] + ["nan"] + ISYM4_CD[7:]))
 write("ldt_intensity_inf.ldt", ldt(intensities=ISYM4_CD[:6] + ["inf"] + ISYM4_CD[7:]))
+
+# Negative intensities: noise (|v| <= 1e-3 x peak 300) -> W, beyond -> E; cd/klm x flux overflowing -> E.
+write("ldt_intensity_negative_noise.ldt", ldt(intensities=ISYM4_CD[:14] + ["-0.25"]))
+write("ldt_intensity_negative_large.ldt", ldt(intensities=ISYM4_CD[:6] + ["-160"] + ISYM4_CD[7:]))
+write("ldt_intensity_overflow.ldt", ldt(lamps=[("1", "LED", "10000", "3000K", "80", "10")],
+                                        intensities=ISYM4_CD[:6] + ["1e308"] + ISYM4_CD[7:]))
+# Line endings other than the spec's CR LF, and a BOM.
+write("ldt_lf_only.ldt", ldt(intensities=ISYM4_CD, nl="\n"))
+write("ldt_bom.ldt", b"\xef\xbb\xbf" + ldt(intensities=ISYM4_CD).encode())
 
 # Item 15: negative lamp count = absolute photometry.
 write("ldt_absolute_negative_lamps.ldt", ldt(lamps=[("-1", "LED", "1500", "3000K", "80", "12")],
