@@ -78,6 +78,16 @@ std::vector<Diagnostic> validate(const Photometry& p) {
     }
   }
 
+  // C0 and C360 are one plane; a file storing both should give them the same values.
+  if (p.type == PhotometricType::C && nh > 1 && std::abs(p.horizontal_deg.front()) < 1e-9 &&
+      std::abs(p.horizontal_deg.back() - 360.0) < 1e-9) {
+    double worst = 0;
+    for (std::size_t iv = 0; iv < nv; ++iv) worst = std::max(worst, std::abs(p.at(0, iv) - p.at(nh - 1, iv)));
+    if (worst > 0.01 * peak)
+      add(Severity::warning, line_of(p.source.candela_lines, (nh - 1) * nv), "candela",
+          "planes C0 and C360 differ by up to " + num(worst) + " cd although they are one plane; lumx uses their mean");
+  }
+
   PhotometricSummary s;
   try {
     s = summarize(p);

@@ -2,8 +2,9 @@
 //
 // Built once from a Photometry: the stored subset is mirrored by its symmetry (lumx/symmetry.h), the
 // vertical angle becomes a polar angle theta in [0,180] (gamma for Type C, V+90 for A and B, so that the
-// solid-angle element is sin(theta) dtheta dphi for every type), and pole rows are replaced by their
-// azimuth-weighted mean so that the interpolant is single-valued, hence continuous, at the poles.
+// solid-angle element is sin(theta) dtheta dphi for every type), pole rows are replaced by their
+// azimuth-weighted mean and a C360 plane and C0 by their mean, so that the interpolant is single-valued,
+// hence continuous, at the poles and across the seam.
 //
 // intensity() is bilinear in (horizontal, theta); it wraps across the 0/360 seam when the planes cover
 // the circle, and is zero outside the measured vertical range (e.g. above gamma 90 for a downlight file).
@@ -46,6 +47,7 @@ class IntensityTable {
       if (!(az_[i] > az_[i - 1])) throw std::invalid_argument("IntensityTable: horizontal angles not increasing");
     cd_ = std::move(full.candela);
     periodic_ = type_ == PhotometricType::C || (az_.back() - az_.front() >= 360.0 - 1e-9);
+    average_seam_planes();
     average_pole_rows();
   }
 
@@ -158,6 +160,18 @@ class IntensityTable {
     const double c00 = cd_[i0 * nt + j], c01 = cd_[i0 * nt + j + 1];
     const double c10 = cd_[i1 * nt + j], c11 = cd_[i1 * nt + j + 1];
     return (1 - ta) * ((1 - tt) * c00 + tt * c01) + ta * ((1 - tt) * c10 + tt * c11);
+  }
+
+  // A table that stores both C0 and C360 (IES with no symmetry) holds two values for one direction;
+  // measured files often differ there. Both become their mean, so the interpolant is continuous
+  // across the seam and a format that stores C0 only (EULUMDAT) carries the same distribution.
+  void average_seam_planes() {
+    const std::size_t nh = az_.size(), nt = th_.size();
+    if (!periodic_ || nh < 2 || az_.back() - az_.front() < 360.0 - 1e-9) return;
+    for (std::size_t j = 0; j < nt; ++j) {
+      const double mean = 0.5 * (cd_[j] + cd_[(nh - 1) * nt + j]);
+      cd_[j] = cd_[(nh - 1) * nt + j] = mean;
+    }
   }
 
   // At theta = 0 or 180 every plane meets in one direction; use the plane-width-weighted mean there.

@@ -1,0 +1,145 @@
+// The lumx command-line tool as a user runs it: help, version, usage errors, and each subcommand on
+// real files.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int status = -1;
+  std::string out;  // stdout and stderr, merged
+};
+
+CliRun run(const std::string& args, bool stderr_too = true) {
+  const std::string cmd = std::string("\"") + LUMX_CLI_PATH + "\" " + args + (stderr_too ? " 2>&1" : " 2>/dev/null");
+  CliRun r;
+  FILE* f = popen(cmd.c_str(), "r");
+  if (!f) return r;
+  std::array<char, 4096> buf{};
+  std::size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), f)) > 0) r.out.append(buf.data(), n);
+  const int st = pclose(f);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::string q(const fs::path& p) { return "\"" + p.string() + "\""; }
+
+fs::path scratch() {
+  const fs::path d = fs::temp_directory_path() / "lumx_cli_test";
+  fs::create_directories(d);
+  return d;
+}
+
+const fs::path kSample = fs::path(LUMX_TEST_DATA_DIR) / "../../samples/downlight.ies";
+
+}  // namespace
+
+TEST(Cli, HelpAndVersion) {
+  const CliRun h = run("--help");
+  EXPECT_EQ(h.status, 0);
+  for (const char* cmd : {"info", "check", "convert", "plot"}) EXPECT_NE(h.out.find(cmd), std::string::npos) << cmd;
+  const CliRun c = run("convert --help");
+  EXPECT_EQ(c.status, 0);
+  EXPECT_NE(c.out.find("--rotate-c"), std::string::npos);
+  const CliRun v = run("--version");
+  EXPECT_EQ(v.status, 0);
+  EXPECT_NE(v.out.find("0.1.0"), std::string::npos);
+  EXPECT_NE(v.out.find("LM-63-2019"), std::string::npos);
+  EXPECT_NE(v.out.find("EULUMDAT"), std::string::npos);
+}
+
+TEST(Cli, UsageErrorsGoToStderrWithNonZeroStatus) {
+  const CliRun none = run("", false);
+  EXPECT_NE(none.status, 0);
+  EXPECT_TRUE(none.out.empty()) << "usage must go to stderr";
+  const CliRun bad = run("info", false);
+  EXPECT_NE(bad.status, 0);
+  const CliRun unknown = run("frobnicate x", false);
+  EXPECT_NE(unknown.status, 0);
+}
+
+TEST(Cli, MissingAndBadFiles) {
+  const CliRun m = run("info /nonexistent/lumx.ies");
+  EXPECT_EQ(m.status, 1);
+  EXPECT_NE(m.out.find("/nonexistent/lumx.ies"), std::string::npos);
+  const fs::path bad = fs::path(LUMX_TEST_DATA_DIR) / "photometry/NVIDIA+MDL-SDK/test_file_format_error.ies";
+  const CliRun b = run("check " + q(bad));
+  EXPECT_EQ(b.status, 1);
+  EXPECT_NE(b.out.find("test_file_format_error.ies:3: error: number of lamps:"), std::string::npos) << b.out;
+}
+
+TEST(Cli, InfoTextAndJson) {
+  const CliRun t = run("info " + q(kSample));
+  EXPECT_EQ(t.status, 0) << t.out;
+  EXPECT_NE(t.out.find("quadrant"), std::string::npos);
+  const CliRun j = run("info --json " + q(kSample), false);
+  ASSERT_EQ(j.status, 0);
+  const auto doc = nlohmann::json::parse(j.out);
+  // The sample's analytic flux is 2125 lm (see samples/README.md); the 2.5 degree table integrates
+  // within 0.2 % of it.
+  EXPECT_NEAR(doc["flux_lm"].get<double>(), 2125.0, 0.002 * 2125.0);
+  EXPECT_EQ(doc["symmetry"], "quadrant (C0-C180 and C90-C270)");
+  EXPECT_GT(doc["c0_c180"]["beam_deg"].get<double>(), doc["c90_c270"]["beam_deg"].get<double>());
+}
+
+TEST(Cli, CheckClassifiesEveryRealFile) {
+  const auto files = lumx_test::shared_photometry_files({".ies", ".ldt"});
+  if (files.empty()) GTEST_SKIP() << "../shared not present";
+  std::string args = "check --json";
+  for (const auto& f : files) args += " " + q(f);
+  const CliRun r = run(args, false);
+  EXPECT_EQ(r.status, 1);  // one intentionally invalid file
+  const auto doc = nlohmann::json::parse(r.out);
+  ASSERT_EQ(doc.size(), files.size());
+  std::size_t bad = 0;
+  for (const auto& e : doc) {
+    if (!e["ok"].get<bool>()) {
+      ++bad;
+      EXPECT_NE(e["file"].get<std::string>().find("test_file_format_error.ies"), std::string::npos) << e.dump();
+    }
+  }
+  EXPECT_EQ(bad, 1u);
+}
+
+TEST(Cli, ConvertRoundTripAndPlot) {
+  const fs::path d = scratch();
+  fs::remove(d / "s.ldt");
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(d / "s.ldt")).status, 0);
+  ASSERT_EQ(run("convert " + q(d / "s.ldt") + " " + q(d / "s.ies") + " --ies-version 2002").status, 0);
+  EXPECT_EQ(lumx_test::read_text(d / "s.ies").rfind("IESNA:LM-63-2002", 0), 0u);
+  const auto a = nlohmann::json::parse(run("info --json " + q(kSample), false).out);
+  const auto b = nlohmann::json::parse(run("info --json " + q(d / "s.ies"), false).out);
+  EXPECT_NEAR(a["flux_lm"].get<double>(), b["flux_lm"].get<double>(), 1e-6 * a["flux_lm"].get<double>());
+  const CliRun c = run("check " + q(d / "s.ldt") + " " + q(d / "s.ies"));
+  EXPECT_EQ(c.status, 0) << c.out;
+
+  ASSERT_EQ(run("plot " + q(kSample) + " -o " + q(d / "p.png")).status, 0);
+  const std::string png = lumx_test::read_text(d / "p.png");
+  ASSERT_GT(png.size(), 1000u);
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  ASSERT_EQ(run("plot " + q(kSample) + " -o " + q(d / "p.svg")).status, 0);
+  EXPECT_NE(lumx_test::read_text(d / "p.svg").find("<svg"), std::string::npos);
+  EXPECT_NE(run("plot " + q(kSample) + " -o " + q(d / "p.bmp")).status, 0);
+}
+
+TEST(Cli, FailedConvertLeavesThePreviousFile) {
+  const fs::path d = scratch();
+  const fs::path out = d / "keep.ies";
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(out)).status, 0);
+  const std::string before = lumx_test::read_text(out);
+  const fs::path bad = fs::path(LUMX_TEST_DATA_DIR) / "photometry/NVIDIA+MDL-SDK/test_file_format_error.ies";
+  EXPECT_EQ(run("convert " + q(bad) + " " + q(out)).status, 1);
+  EXPECT_EQ(lumx_test::read_text(out), before);
+  for (const auto& e : fs::directory_iterator(d))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "temporary file left: " << e.path();
+}
