@@ -185,6 +185,7 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
 
   // ---- line 10 values: lamps, lumens, multiplier, counts, type, units, opening ----
   const long n_lamps = in.next_integer("number of lamps", 0, 1000000);
+  if (n_lamps == 0) warn(in.last_line(), "number of lamps", "0 lamps; read as 1");
   const double lumens = in.next_number("lumens per lamp");
   const double multiplier = in.next_number("candela multiplier");
   if (!(multiplier > 0)) in.fail_at_last("candela multiplier", "must be positive");
@@ -265,8 +266,13 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
   const std::size_t ncd = nvs * nhs;
   p.candela = in.next_values(ncd, "candela value", &p.source.candela_lines);
   double peak = 0;
-  for (double& c : p.candela) {
+  for (std::size_t i = 0; i < ncd; ++i) {
+    double& c = p.candela[i];
     c *= multiplier;
+    if (!std::isfinite(c))  // finite value x finite multiplier can still overflow
+      throw_at_line(name, static_cast<int>(p.source.candela_lines[i]),
+                    "candela[h=" + std::to_string(i / nvs) + "][v=" + std::to_string(i % nvs) + "]",
+                    "value times the candela multiplier overflows");
     peak = std::max(peak, c);
   }
   std::size_t n_small_negative = 0;
