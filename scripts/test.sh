@@ -5,5 +5,6 @@ cd "$(dirname "$0")/.."
 dir=$(bash scripts/build.sh "$@" | tail -n 1)
 if [ "${1:-}" = "--sanitize" ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  export LSAN_OPTIONS="suppressions=$(pwd)/scripts/lsan.supp"
 fi
 ctest --test-dir "$dir" --output-on-failure -j "$(nproc)"
