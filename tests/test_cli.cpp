@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <string>
 
+#include <unistd.h>
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -34,8 +36,10 @@ CliRun run(const std::string& args, bool stderr_too = true) {
 
 std::string q(const fs::path& p) { return "\"" + p.string() + "\""; }
 
-fs::path scratch() {
-  const fs::path d = fs::temp_directory_path() / "lumx_cli_test";
+/// A fresh folder per test (ctest runs tests in parallel processes).
+fs::path scratch(const std::string& test) {
+  const fs::path d = fs::temp_directory_path() / ("lumx_cli_" + test + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
   fs::create_directories(d);
   return d;
 }
@@ -112,7 +116,7 @@ TEST(Cli, CheckClassifiesEveryRealFile) {
 }
 
 TEST(Cli, ConvertRoundTripAndPlot) {
-  const fs::path d = scratch();
+  const fs::path d = scratch("convert");
   fs::remove(d / "s.ldt");
   ASSERT_EQ(run("convert " + q(kSample) + " " + q(d / "s.ldt")).status, 0);
   ASSERT_EQ(run("convert " + q(d / "s.ldt") + " " + q(d / "s.ies") + " --ies-version 2002").status, 0);
@@ -133,7 +137,7 @@ TEST(Cli, ConvertRoundTripAndPlot) {
 }
 
 TEST(Cli, FailedConvertLeavesThePreviousFile) {
-  const fs::path d = scratch();
+  const fs::path d = scratch("keep");
   const fs::path out = d / "keep.ies";
   ASSERT_EQ(run("convert " + q(kSample) + " " + q(out)).status, 0);
   const std::string before = lumx_test::read_text(out);

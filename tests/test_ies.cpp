@@ -12,6 +12,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 using namespace lumx;
 namespace fs = std::filesystem;
 
@@ -176,7 +178,7 @@ TEST(IesRead, TiltIncludeIsReadAppliedAndWritten) {
 }
 
 TEST(IesRead, ExternalTiltFileOnlyFromTheSameFolder) {
-  const fs::path dir = fs::temp_directory_path() / "lumx_tilt_test";
+  const fs::path dir = fs::temp_directory_path() / ("lumx_tilt_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "sub");
   std::string text = kMinimal2002;
