@@ -73,7 +73,13 @@ class NumberStream {
         throw_at_line(file_, last_line_, field,
                       "file ends after " + std::to_string(i) + " of " + std::to_string(n) + " values (missing value " +
                           std::to_string(i + 1) + ")");
-      out.push_back(next_number(field + " " + std::to_string(i + 1) + " of " + std::to_string(n)));
+      const Token& t = tokens_[pos_++];
+      last_line_ = t.line;
+      double v = 0;
+      if (!parse_number(t.text, v))  // the field name is only built on failure (hot path)
+        throw_at_line(file_, t.line, field + " " + std::to_string(i + 1) + " of " + std::to_string(n),
+                      "expected a finite number, found '" + std::string(t.text.substr(0, 40)) + "'");
+      out.push_back(v);
       if (lines) lines->push_back(static_cast<std::uint32_t>(last_line_));
     }
     return out;
