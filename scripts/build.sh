@@ -4,11 +4,12 @@
 #   --sanitize   -> build-asan/   (Debug, AddressSanitizer + UndefinedBehaviorSanitizer)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/deps.sh
+bash scripts/deps.sh >&2
 dir=build; extra=(-DCMAKE_BUILD_TYPE=RelWithDebInfo)
 if [ "${1:-}" = "--sanitize" ]; then
   dir=build-asan; extra=(-DCMAKE_BUILD_TYPE=Debug -DLUMX_SANITIZE=ON -DLUMX_BUILD_BENCH=OFF)
 fi
-cmake -S . -B "$dir" -G Ninja "${extra[@]}" >/dev/null
-cmake --build "$dir" -j "$(nproc)"
+# Progress and errors go to stderr; stdout carries only the build folder, for the other scripts.
+cmake -S . -B "$dir" -G Ninja "${extra[@]}" >&2
+cmake --build "$dir" -j "$(nproc)" >&2
 echo "$dir"
