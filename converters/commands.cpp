@@ -21,14 +21,18 @@ namespace {
 
 using nlohmann::json;
 
-void print_diag(const lumx::Diagnostic& d) { std::fprintf(stderr, "%s\n", d.str().c_str()); }
+void print_diag(const lumx::Diagnostic& d) {
+  std::fprintf(stderr, "%s\n", d.str().c_str());
+}
 
 /// Reads a file, printing warnings to stderr (or collecting them into `warnings` if given).
 lumx::Photometry load(const std::string& path, std::vector<lumx::Diagnostic>* warnings = nullptr) {
   lumx::ReadOptions o;
   o.warnings = [warnings](const lumx::Diagnostic& d) {
-    if (warnings) warnings->push_back(d);
-    else print_diag(d);
+    if (warnings)
+      warnings->push_back(d);
+    else
+      print_diag(d);
   };
   return lumx::read_photometry(path, o);
 }
@@ -40,7 +44,9 @@ std::string title_of(const lumx::Photometry& p) {
 }
 
 json spread_json(const lumx::Spread& s) {
-  return {{"beam_deg", s.beam_deg}, {"field_deg", s.field_deg}, {"peak_cd", s.peak_cd},
+  return {{"beam_deg", s.beam_deg},
+          {"field_deg", s.field_deg},
+          {"peak_cd", s.peak_cd},
           {"peak_angle_deg", s.peak_angle_deg}};
 }
 
@@ -48,6 +54,20 @@ json diag_json(const lumx::Diagnostic& d) {
   json j = {{"severity", lumx::to_string(d.severity)}, {"field", d.field}, {"message", d.message}};
   if (d.line > 0) j["line"] = d.line;
   return j;
+}
+
+/// Runs a subcommand body, turning library errors into a located message on stderr and status 1.
+template <class Body>
+int guarded(const std::string& file, Body body) {
+  try {
+    return body();
+  } catch (const lumx::Error& e) {
+    print_diag(e.diagnostic());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", file.c_str(), e.what());
+    return 1;
+  }
 }
 
 }  // namespace
@@ -62,7 +82,7 @@ void print_version() {
 }
 
 int run_info(const InfoArgs& a) {
-  try {
+  return guarded(a.file, [&] {
     std::vector<lumx::Diagnostic> warnings;
     const lumx::Photometry p = load(a.file, a.json ? &warnings : nullptr);
     const lumx::PhotometricSummary s = lumx::summarize(p);
@@ -71,33 +91,40 @@ int run_info(const InfoArgs& a) {
     if (a.json) {
       json lamps = json::array();
       for (const auto& l : p.lamp_sets)
-        lamps.push_back({{"count", l.count}, {"type", l.type}, {"flux_lm", l.flux_lm}, {"watts_W", l.watts},
-                         {"color", l.color}, {"cri", l.cri}});
-      json j = {{"file", a.file},
-                {"format", p.source.format},
-                {"version", p.source.version},
-                {"photometric_type", lumx::to_string(p.type)},
-                {"symmetry", lumx::to_string(p.symmetry)},
-                {"horizontal_angles", {{"count", h.size()}, {"first_deg", h.front()}, {"last_deg", h.back()}}},
-                {"vertical_angles", {{"count", v.size()}, {"first_deg", v.front()}, {"last_deg", v.back()}}},
-                {"absolute_photometry", p.absolute},
-                {"flux_lm", s.flux_lm},
-                {"rated_lamp_flux_lm", s.rated_lamp_flux_lm},
-                {"max_cd", s.max_cd},
-                {"max_direction_deg", {s.max_horizontal_deg, s.max_vertical_deg}},
-                {"c0_c180", spread_json(s.c0_c180)},
-                {"c90_c270", spread_json(s.c90_c270)},
-                {"downward_flux_fraction", s.downward_fraction},
-                {"light_output_ratio", s.light_output_ratio ? json(*s.light_output_ratio) : json(nullptr)},
-                {"ballast_factor", p.ballast_factor},
-                {"input_watts_W", p.input_watts},
-                {"efficacy_lm_per_W", s.efficacy_lm_per_w},
-                {"opening_m",
-                 {{"width", p.opening.width_m}, {"length", p.opening.length_m}, {"height", p.opening.height_m},
-                  {"shape", lumx::to_string(p.opening.shape())}}},
-                {"lamps", lamps},
-                {"tilt", p.tilt ? json{{"source", p.tilt->source}, {"pairs", p.tilt->angles_deg.size()}} : json(nullptr)},
-                {"warnings", json::array()}};
+        lamps.push_back({{"count", l.count},
+                         {"type", l.type},
+                         {"flux_lm", l.flux_lm},
+                         {"watts_W", l.watts},
+                         {"color", l.color},
+                         {"cri", l.cri}});
+      json j = {
+          {"file", a.file},
+          {"format", p.source.format},
+          {"version", p.source.version},
+          {"photometric_type", lumx::to_string(p.type)},
+          {"symmetry", lumx::to_string(p.symmetry)},
+          {"horizontal_angles", {{"count", h.size()}, {"first_deg", h.front()}, {"last_deg", h.back()}}},
+          {"vertical_angles", {{"count", v.size()}, {"first_deg", v.front()}, {"last_deg", v.back()}}},
+          {"absolute_photometry", p.absolute},
+          {"flux_lm", s.flux_lm},
+          {"rated_lamp_flux_lm", s.rated_lamp_flux_lm},
+          {"max_cd", s.max_cd},
+          {"max_direction_deg", {s.max_horizontal_deg, s.max_vertical_deg}},
+          {"c0_c180", spread_json(s.c0_c180)},
+          {"c90_c270", spread_json(s.c90_c270)},
+          {"downward_flux_fraction", s.downward_fraction},
+          {"light_output_ratio", s.light_output_ratio ? json(*s.light_output_ratio) : json(nullptr)},
+          {"ballast_factor", p.ballast_factor},
+          {"input_watts_W", p.input_watts},
+          {"efficacy_lm_per_W", s.efficacy_lm_per_w},
+          {"opening_m",
+           {{"width", p.opening.width_m},
+            {"length", p.opening.length_m},
+            {"height", p.opening.height_m},
+            {"shape", lumx::to_string(p.opening.shape())}}},
+          {"lamps", lamps},
+          {"tilt", p.tilt ? json{{"source", p.tilt->source}, {"pairs", p.tilt->angles_deg.size()}} : json(nullptr)},
+          {"warnings", json::array()}};
       for (const auto& w : warnings) j["warnings"].push_back(diag_json(w));
       std::cout << j.dump(2) << "\n";
       return 0;
@@ -105,8 +132,8 @@ int run_info(const InfoArgs& a) {
     std::printf("file:          %s\n", a.file.c_str());
     std::printf("format:        %s %s\n", p.source.format.c_str(), p.source.version.c_str());
     std::printf("type:          %s, symmetry %s\n", lumx::to_string(p.type), lumx::to_string(p.symmetry));
-    std::printf("grid:          %zu horizontal (%g..%g deg) x %zu vertical (%g..%g deg) stored\n", h.size(),
-                h.front(), h.back(), v.size(), v.front(), v.back());
+    std::printf("grid:          %zu horizontal (%g..%g deg) x %zu vertical (%g..%g deg) stored\n", h.size(), h.front(),
+                h.back(), v.size(), v.front(), v.back());
     if (p.absolute) {
       std::printf("flux:          %.1f lm (absolute photometry)\n", s.flux_lm);
     } else {
@@ -115,13 +142,12 @@ int run_info(const InfoArgs& a) {
       std::printf("\n");
     }
     std::printf("max intensity: %.1f cd at (%g, %g) deg\n", s.max_cd, s.max_horizontal_deg, s.max_vertical_deg);
-    std::printf("beam (50 %%):   %.1f deg in C0-C180, %.1f deg in C90-C270\n", s.c0_c180.beam_deg,
-                s.c90_c270.beam_deg);
+    std::printf("beam (50 %%):   %.1f deg in C0-C180, %.1f deg in C90-C270\n", s.c0_c180.beam_deg, s.c90_c270.beam_deg);
     std::printf("field (10 %%):  %.1f deg in C0-C180, %.1f deg in C90-C270\n", s.c0_c180.field_deg,
                 s.c90_c270.field_deg);
     std::printf("downward flux: %.1f %%\n", 100 * s.downward_fraction);
-    std::printf("opening:       %g x %g x %g m (width x length x height), %s\n", p.opening.width_m,
-                p.opening.length_m, p.opening.height_m, lumx::to_string(p.opening.shape()));
+    std::printf("opening:       %g x %g x %g m (width x length x height), %s\n", p.opening.width_m, p.opening.length_m,
+                p.opening.height_m, lumx::to_string(p.opening.shape()));
     for (const auto& l : p.lamp_sets)
       std::printf("lamps:         %d x %s%s%.1f lm, %.1f W\n", l.count, l.type.c_str(), l.type.empty() ? "" : ", ",
                   l.flux_lm, l.watts);
@@ -132,13 +158,7 @@ int run_info(const InfoArgs& a) {
       std::printf("tilt:          %s, %zu angles, lamp geometry %d\n", p.tilt->source.c_str(),
                   p.tilt->angles_deg.size(), p.tilt->lamp_geometry);
     return 0;
-  } catch (const lumx::Error& e) {
-    print_diag(e.diagnostic());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: error: %s\n", a.file.c_str(), e.what());
-    return 1;
-  }
+  });
 }
 
 int run_check(const CheckArgs& a) {
@@ -174,19 +194,19 @@ int run_check(const CheckArgs& a) {
 }
 
 int run_convert(const ConvertArgs& a) {
-  try {
+  return guarded(a.in, [&] {
     lumx::Photometry p = load(a.in);
     if (a.apply_tilt) {
-      if (!p.tilt) std::fprintf(stderr, "%s: warning: TILT: the file has no TILT data; --apply-tilt ignored\n",
-                                a.in.c_str());
+      if (!p.tilt)
+        std::fprintf(stderr, "%s: warning: TILT: the file has no TILT data; --apply-tilt ignored\n", a.in.c_str());
       p = lumx::apply_tilt(p, a.tilt_deg);
       p.tilt.reset();
     }
     const std::string ext = std::filesystem::path(a.out).extension().string();
     const bool to_ldt = ext == ".ldt" || ext == ".LDT";
     if (to_ldt && p.type != lumx::PhotometricType::C) {
-      std::fprintf(stderr, "%s: note: Type %s resampled to Type C on a 1 x 1 degree grid for EULUMDAT\n",
-                   a.in.c_str(), lumx::to_string(p.type));
+      std::fprintf(stderr, "%s: note: Type %s resampled to Type C on a 1 x 1 degree grid for EULUMDAT\n", a.in.c_str(),
+                   lumx::to_string(p.type));
       p = lumx::to_type_c(p, 1.0, 1.0);
     }
     if (a.rotate_c_deg != 0) p = lumx::rotate_c_planes(p, a.rotate_c_deg);
@@ -198,17 +218,11 @@ int run_convert(const ConvertArgs& a) {
     const double f0 = lumx::summarize(p).flux_lm;
     std::printf("%s -> %s (flux %.2f lm)\n", a.in.c_str(), a.out.c_str(), f0);
     return 0;
-  } catch (const lumx::Error& e) {
-    print_diag(e.diagnostic());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: error: %s\n", a.in.c_str(), e.what());
-    return 1;
-  }
+  });
 }
 
 int run_plot(const PlotArgs& a) {
-  try {
+  return guarded(a.file, [&] {
     const lumx::Photometry p = load(a.file);
     lumx::PolarPlotOptions o;
     o.title = a.title.empty() ? title_of(p) : a.title;
@@ -217,13 +231,7 @@ int run_plot(const PlotArgs& a) {
     lumx::write_polar_plot(p, a.out, o);
     std::printf("%s\n", a.out.c_str());
     return 0;
-  } catch (const lumx::Error& e) {
-    print_diag(e.diagnostic());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: error: %s\n", a.file.c_str(), e.what());
-    return 1;
-  }
+  });
 }
 
 }  // namespace lumx_cli

@@ -46,8 +46,7 @@ const Command kCommands[] = {
        c.add_option("--rotate-c", g_convert.rotate_c_deg,
                     "rotate C-planes by DEG (default 0; 90 or -90 switches between the 'C0 along' and "
                     "'C0 across the luminaire length' readings)");
-       c.add_option("--digits", g_convert.digits, "significant digits written (default 7)")
-           ->check(CLI::Range(3, 17));
+       c.add_option("--digits", g_convert.digits, "significant digits written (default 7)")->check(CLI::Range(3, 17));
        c.add_option("--apply-tilt", g_convert.tilt_deg,
                     "fold the TILT multiplier at this installed tilt (degrees) into the candela values")
            ->each([](const std::string&) { g_convert.apply_tilt = true; });
@@ -67,8 +66,7 @@ const Command kCommands[] = {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"lumx — luminaire data interchange: read, check, convert and plot IES LM-63 and EULUMDAT files",
-               "lumx"};
+  CLI::App app{"lumx — luminaire data interchange: read, check, convert and plot IES LM-63 and EULUMDAT files", "lumx"};
   app.require_subcommand(0, 1);
   bool version = false;
   app.add_flag("--version", version, "print library and file-format versions");
