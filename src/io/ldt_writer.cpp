@@ -98,7 +98,7 @@ std::string format_ldt(const Photometry& p, const LdtWriteOptions& options) {
       fail(p, "symmetry", "lateral (Type A/B) symmetry has no EULUMDAT equivalent");
   }
 
-  // Full circle: all planes in [0,360); a 360 plane duplicating C0 is dropped.
+  // Full circle: all planes in [0,360); a C360 plane is folded into C0 (see the intensity block below).
   AngleTable full;
   try {
     full = expand(stored_table(p), p.symmetry);
@@ -257,9 +257,13 @@ std::string format_ldt(const Photometry& p, const LdtWriteOptions& options) {
   for (std::size_t k = 0; k < 10; ++k) number(h.direct_ratios.size() == 10 ? h.direct_ratios[k] : 0.0);
   for (double c : call) number(c);
   for (double g : p.vertical_deg) number(g);
+  // A model holding both C0 and C360 (IES without symmetry) may differ there; EULUMDAT has room for one
+  // plane, so write their mean, which is what IntensityTable uses for that direction.
+  const bool has_c360 = isym == 0 && nh > 1 && p.horizontal_deg.front() == 0 && p.horizontal_deg.back() == 360;
   for (std::size_t ih : order)
     for (std::size_t j = 0; j < nv; ++j) {
-      const double v = p.at(ih, j) * scale;
+      const double cd = (has_c360 && ih == 0) ? 0.5 * (p.at(0, j) + p.at(nh - 1, j)) : p.at(ih, j);
+      const double v = cd * scale;
       if (!std::isfinite(v)) fail(p, "lamp flux", "cd/klm overflow: lamp flux " + num(written_flux, digits) + " lm");
       number(v);
     }
