@@ -126,7 +126,7 @@ int run_info(const InfoArgs& a) {
           {"tilt", p.tilt ? json{{"source", p.tilt->source}, {"pairs", p.tilt->angles_deg.size()}} : json(nullptr)},
           {"warnings", json::array()}};
       for (const auto& w : warnings) j["warnings"].push_back(diag_json(w));
-      std::cout << j.dump(2) << "\n";
+      std::cout << j.dump(2, ' ', false, json::error_handler_t::replace) << "\n";
       return 0;
     }
     std::printf("file:          %s\n", a.file.c_str());
@@ -171,6 +171,8 @@ int run_check(const CheckArgs& a) {
       for (auto& d : lumx::validate(p)) findings.push_back(d);
     } catch (const lumx::Error& e) {
       findings.push_back(e.diagnostic());
+    } catch (const std::exception& e) {  // e.g. out of memory: report it as a finding of this file
+      findings.push_back(lumx::Diagnostic{lumx::Severity::error, file, 0, -1, "file", e.what()});
     }
     bool bad = false;
     for (auto& d : findings) {
@@ -189,7 +191,7 @@ int run_check(const CheckArgs& a) {
       if (!bad) std::printf("%s: OK (with %zu warning(s))\n", file.c_str(), findings.size());
     }
   }
-  if (a.json) std::cout << all.dump(2) << "\n";
+  if (a.json) std::cout << all.dump(2, ' ', false, json::error_handler_t::replace) << "\n";
   return status;
 }
 
@@ -202,8 +204,12 @@ int run_convert(const ConvertArgs& a) {
       p = lumx::apply_tilt(p, a.tilt_deg);
       p.tilt.reset();
     }
-    const std::string ext = std::filesystem::path(a.out).extension().string();
-    const bool to_ldt = ext == ".ldt" || ext == ".LDT";
+    const bool to_ldt = lumx::format_from_extension(a.out) == lumx::PhotometryFormat::ldt;
+    if (to_ldt && p.tilt)
+      std::fprintf(stderr,
+                   "%s: warning: TILT: EULUMDAT cannot store TILT multipliers; they are dropped (use "
+                   "--apply-tilt DEG to fold them in at an installed tilt)\n",
+                   a.in.c_str());
     if (to_ldt && p.type != lumx::PhotometricType::C) {
       std::fprintf(stderr, "%s: note: Type %s resampled to Type C on a 1 x 1 degree grid for EULUMDAT\n", a.in.c_str(),
                    lumx::to_string(p.type));
@@ -213,9 +219,10 @@ int run_convert(const ConvertArgs& a) {
     lumx::WriteOptions w;
     w.ies.version = a.ies_version == "2002" ? lumx::IesVersion::lm63_2002 : lumx::IesVersion::lm63_2019;
     w.ies.significant_digits = a.digits;
+    w.ies.expand_c90_c270 = !a.keep_c90_c270;
     w.ldt.significant_digits = a.digits;
+    const double f0 = lumx::summarize(p).flux_lm;  // before writing: a failure must not replace the output
     lumx::write_photometry(p, a.out, w);
-    const double f0 = lumx::summarize(p).flux_lm;
     std::printf("%s -> %s (flux %.2f lm)\n", a.in.c_str(), a.out.c_str(), f0);
     return 0;
   });

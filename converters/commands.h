@@ -22,6 +22,7 @@ struct ConvertArgs {
   int digits = 7;                    ///< significant digits written
   double tilt_deg = 0;               ///< installed tilt at which TILT multipliers are applied
   bool apply_tilt = false;
+  bool keep_c90_c270 = false;        ///< write IES C90-C270 symmetry as 90..270 instead of 0..360
 };
 struct PlotArgs {
   std::string file, out, title;

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <functional>
 
@@ -22,6 +23,17 @@ lumx_cli::InfoArgs g_info;
 lumx_cli::CheckArgs g_check;
 lumx_cli::ConvertArgs g_convert;
 lumx_cli::PlotArgs g_plot;
+
+/// Refuses nan/inf for angle options (CLI11's number parsing accepts them).
+const CLI::Validator finite(
+    [](std::string& v) {
+      try {
+        return std::isfinite(std::stod(v)) ? std::string() : "must be a finite number of degrees";
+      } catch (const std::exception&) {
+        return std::string("must be a number");
+      }
+    },
+    "DEG");
 
 const Command kCommands[] = {
     {"info", "Summarise a photometry file (IES or EULUMDAT): format, grid, flux, peak, beam/field angles",
@@ -45,11 +57,16 @@ const Command kCommands[] = {
            ->check(CLI::IsMember({"2002", "2019"}));
        c.add_option("--rotate-c", g_convert.rotate_c_deg,
                     "rotate C-planes by DEG (default 0; 90 or -90 switches between the 'C0 along' and "
-                    "'C0 across the luminaire length' readings)");
+                    "'C0 across the luminaire length' readings)")
+           ->check(finite);
        c.add_option("--digits", g_convert.digits, "significant digits written (default 7)")->check(CLI::Range(3, 17));
        c.add_option("--apply-tilt", g_convert.tilt_deg,
                     "fold the TILT multiplier at this installed tilt (degrees) into the candela values")
+           ->check(finite)
            ->each([](const std::string&) { g_convert.apply_tilt = true; });
+       c.add_flag("--keep-c90-c270", g_convert.keep_c90_c270,
+                  "write C90-C270 symmetric data as IES horizontal angles 90..270 (LM-63 allows it, but several "
+                  "readers misplace it; by default it is written as 0..360)");
        c.callback([&st] { st = lumx_cli::run_convert(g_convert); });
      }},
     {"plot", "Draw the polar intensity diagram (C0-C180 and C90-C270) as SVG or PNG",

@@ -97,8 +97,6 @@ std::vector<Diagnostic> validate(const Photometry& p) {
   }
   if (!(s.flux_lm > 0)) add(Severity::error, 0, "candela", "total flux is not positive");
 
-  if (p.absolute && p.lamp_sets.size() == 1 && p.lamp_sets[0].flux_lm > 0 && p.source.format == "IES")
-    add(Severity::warning, 0, "lumens per lamp", "absolute photometry but a lamp flux is stated");
   if (s.light_output_ratio && *s.light_output_ratio > 1.0 + 1e-3)
     add(Severity::warning, 0, "lumens per lamp",
         "luminaire flux " + num(s.flux_lm) + " lm exceeds the rated lamp flux " + num(s.rated_lamp_flux_lm) +
@@ -119,9 +117,7 @@ std::vector<Diagnostic> validate(const Photometry& p) {
                                                     p.source.version + ")");
     if (v2019) {
       const double g = p.ies_second_factor;
-      bool ok = false;
-      for (double k : {1.00001, 1.00010, 1.00000, 1.00100, 1.01000, 1.01100, 1.10000, 1.10100, 1.11000, 1.11100})
-        ok = ok || std::abs(g - k) < 5e-6;
+      const bool ok = is_lm63_2019_file_generation_type(g);
       if (!ok) add(Severity::warning, 0, "file generation type", num(g) + " is not a value of LM-63-2019 Table 2");
     }
   }

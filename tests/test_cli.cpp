@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <unistd.h>
@@ -146,4 +147,23 @@ TEST(Cli, FailedConvertLeavesThePreviousFile) {
   EXPECT_EQ(lumx_test::read_text(out), before);
   for (const auto& e : fs::directory_iterator(d))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "temporary file left: " << e.path();
+}
+
+TEST(Cli, JsonStaysValidWithNonUtf8Bytes) {
+  // A Latin-1 byte inside a bad number: the finding quotes it, and the JSON must still parse.
+  const fs::path d = scratch("json");
+  std::ofstream(d / "bad.ies") << "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n5\xB0 1\n";
+  const CliRun r = run("check --json " + q(d / "bad.ies"), false);
+  EXPECT_EQ(r.status, 1);
+  const auto doc = nlohmann::json::parse(r.out);
+  ASSERT_EQ(doc.size(), 1u);
+  EXPECT_FALSE(doc[0]["ok"].get<bool>());
+  EXPECT_EQ(doc[0]["findings"][0]["line"], 7);
+}
+
+TEST(Cli, NonFiniteAnglesAreUsageErrors) {
+  const fs::path d = scratch("nan");
+  EXPECT_NE(run("convert " + q(kSample) + " " + q(d / "o.ies") + " --rotate-c nan", false).status, 0);
+  EXPECT_NE(run("convert " + q(kSample) + " " + q(d / "o.ies") + " --apply-tilt inf", false).status, 0);
+  EXPECT_FALSE(fs::exists(d / "o.ies"));
 }

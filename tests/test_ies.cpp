@@ -319,3 +319,34 @@ TEST(IesRead, LuminousOpeningShapes) {
   EXPECT_DOUBLE_EQ(p.opening.width_m, 0.3048);
   EXPECT_DOUBLE_EQ(p.opening.length_m, 0.6096);
 }
+
+TEST(IesWrite, C90C270SymmetryKeptOrExpanded) {
+  // LM-63-1995 range 90..270 kept by default (exact model round trip); expanded to 0..360 on request,
+  // for readers that mishandle it. Both describe the same distribution.
+  const Photometry p = read_photometry(
+      (lumx_test::data_dir() / "photometry/dlippok+photometric-viewer/symmetry_to_c90c270.ldt").string());
+  ASSERT_EQ(p.symmetry, Symmetry::plane_c90_c270);
+  const Photometry kept = read_ies(format_ies(p), "kept.ies");
+  EXPECT_EQ(kept.symmetry, Symmetry::plane_c90_c270);
+  EXPECT_EQ(kept.horizontal_deg.front(), 90.0);
+  IesWriteOptions o;
+  o.expand_c90_c270 = true;
+  const Photometry full = read_ies(format_ies(p, o), "full.ies");
+  EXPECT_EQ(full.symmetry, Symmetry::none);
+  EXPECT_EQ(full.horizontal_deg.front(), 0.0);
+  EXPECT_EQ(full.horizontal_deg.back(), 360.0);
+  const IntensityTable a(p), b(full);
+  for (double c = 0; c < 360; c += 10)
+    for (double g = 0; g <= 180; g += 5) EXPECT_NEAR(b.at_angles(c, g), a.at_angles(c, g), 1e-6 * a.max_cd());
+}
+
+TEST(IesWrite, RefusesTablesItCannotStateCorrectly) {
+  Photometry p = read_ies(kMinimal2002, "min.ies");
+  p.horizontal_deg[1] = std::nan("");
+  EXPECT_THROW(format_ies(p), Error);
+  p = read_ies(kMinimal2002, "min.ies");
+  p.symmetry = Symmetry::plane_c0_c180;  // but planes 0..90 are stored: would be read back as quadrant
+  EXPECT_THROW(format_ies(p), Error);
+  p = read_ies(kMinimal2002, "min.ies");
+  EXPECT_THROW(rotate_c_planes(p, std::nan("")), std::invalid_argument);
+}

@@ -177,6 +177,10 @@ struct Photometry {
   const Keyword* find_keyword(const std::string& name) const;
 };
 
+/// True for the values of LM-63-2019 Table 2 (file generation type): 1.00001 undefined, 1.00010
+/// simulation, 1.00000 unaccredited lab, +0.00100 lumen-scaled, +0.01000 interpolated, 1.10000 accredited.
+bool is_lm63_2019_file_generation_type(double v);
+
 /// A copy of `p` with every candela value multiplied by the TILT multiplier at `tilt_deg` (the
 /// luminaire's installed tilt). Returns `p` unchanged if it has no TILT data.
 Photometry apply_tilt(const Photometry& p, double tilt_deg);

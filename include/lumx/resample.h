@@ -65,11 +65,16 @@ inline Photometry to_type_c(const Photometry& p, double step_c_deg = 1.0, double
 /// multiple of the plane spacing).
 inline Photometry rotate_c_planes(const Photometry& p, double deg) {
   if (p.type != PhotometricType::C) throw std::invalid_argument("rotate_c_planes: Type C photometry only");
+  if (!std::isfinite(deg)) throw std::invalid_argument("rotate_c_planes: angle is not finite");
   double r = std::fmod(deg, 360.0);
   if (r < 0) r += 360.0;
   if (r < 1e-9 || 360.0 - r < 1e-9 || p.symmetry == Symmetry::rotational) return p;
   AngleTable full = expand(stored_table(p), p.symmetry);
   const std::size_t nv = full.vertical_deg.size();
+  const std::size_t nh = full.horizontal_deg.size();
+  // C0 and C360 are one plane: keep their mean (as IntensityTable does) before C360 is dropped.
+  if (nh > 1 && std::abs(full.horizontal_deg.front()) < 1e-9 && full.horizontal_deg.back() >= 360.0 - 1e-9)
+    for (std::size_t j = 0; j < nv; ++j) full.candela[j] = 0.5 * (full.candela[j] + full.candela[(nh - 1) * nv + j]);
   AngleTable rotated;
   rotated.vertical_deg = full.vertical_deg;
   for (std::size_t i = 0; i < full.horizontal_deg.size(); ++i) {

@@ -35,6 +35,9 @@ void write_file_atomically(const std::string& path, std::string_view bytes) {
   const std::string tmp = (dir / ("." + target.filename().string() + ".tmp" + std::to_string(rd()))).string();
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) fail(path, "create temporary file", errno);
+  // Replacing a file keeps its permission bits.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) ::fchmod(fd, st.st_mode & 07777);
   auto abandon = [&](const char* step, int err) {
     ::close(fd);
     ::unlink(tmp.c_str());
@@ -64,10 +67,13 @@ void write_file_atomically(const std::string& path, std::string_view bytes) {
   }
   // Make the rename itself durable.
   const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
+  if (dfd < 0) fail(path, "open folder for fsync", errno);
+  if (::fsync(dfd) != 0 && errno != EINVAL) {  // EINVAL: the file system cannot sync folders
+    const int err = errno;
     ::close(dfd);
+    fail(path, "fsync folder", err);
   }
+  ::close(dfd);
 }
 
 std::string read_file_bounded(const std::string& path, std::size_t max_bytes) {

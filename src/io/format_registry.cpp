@@ -42,10 +42,15 @@ bool looks_like_ldt(std::string_view head) {
 
 }  // namespace
 
-PhotometryFormat detect_format(const std::string& path, std::string_view head) {
+std::optional<PhotometryFormat> format_from_extension(const std::string& path) {
   const std::string ext = lower_extension(path);
   if (ext == ".ies") return PhotometryFormat::ies;
   if (ext == ".ldt") return PhotometryFormat::ldt;
+  return std::nullopt;
+}
+
+PhotometryFormat detect_format(const std::string& path, std::string_view head) {
+  if (const auto f = format_from_extension(path)) return *f;
   if (looks_like_ies(head)) return PhotometryFormat::ies;
   if (looks_like_ldt(head)) return PhotometryFormat::ldt;
   Diagnostic d;
@@ -67,19 +72,15 @@ Photometry read_photometry(const std::string& path, const ReadOptions& options) 
 }
 
 void write_photometry(const Photometry& p, const std::string& path, const WriteOptions& options) {
-  const std::string ext = lower_extension(path);
-  std::string text;
-  if (ext == ".ies") {
-    text = format_ies(p, options.ies);
-  } else if (ext == ".ldt") {
-    text = format_ldt(p, options.ldt);
-  } else {
+  const auto format = format_from_extension(path);
+  if (!format) {
     Diagnostic d;
     d.file = path;
     d.field = "output format";
-    d.message = "unknown extension '" + ext + "' (expected .ies or .ldt)";
+    d.message = "unknown extension '" + lower_extension(path) + "' (expected .ies or .ldt)";
     throw Error(std::move(d));
   }
+  const std::string text = *format == PhotometryFormat::ies ? format_ies(p, options.ies) : format_ldt(p, options.ldt);
   write_file_atomically(path, text);
 }
 

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 LUMX_NAMESPACE_BEGIN
@@ -68,14 +69,14 @@ std::string version_of_first_line(std::string_view first, bool& has_version_line
     if (c != ' ' && c != '\t') compact.push_back(c);
   has_version_line = true;
   auto note_spaces = [&] {
-    if (compact != u) warn(line, "version", "blanks inside the version line '" + u + "' (LM-63 forbids them)");
+    if (compact != u) warn(line, "version", "blanks inside the version line '" + detail::excerpt(u, 80) + "' (LM-63 forbids them)");
   };
   if (compact == "IESNA91" || compact == "IESNA:LM-63-1991") return note_spaces(), file_format::kIes1991;
   if (compact == "IESNA:LM-63-1995") return note_spaces(), file_format::kIes1995;
   if (compact == "IESNA:LM-63-2002") return note_spaces(), file_format::kIes2002;
   if (compact == "IES:LM-63-2019" || compact == "IESNA:LM-63-2019") return note_spaces(), file_format::kIes2019;
   if (starts_with(compact, "IESNA") || starts_with(compact, "IES:LM-63")) {
-    warn(line, "version", "unknown LM-63 version line '" + std::string(trim(first)) + "'; read as LM-63-2002");
+    warn(line, "version", "unknown LM-63 version line '" + detail::excerpt(trim(first), 80) + "'; read as LM-63-2002");
     return file_format::kIes2002;
   }
   has_version_line = false;
@@ -165,11 +166,20 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
     if (file.empty() || file.find('/') != std::string::npos || file.find('\\') != std::string::npos ||
         file.find(':') != std::string::npos || file == "." || file == "..")
       throw_at_line(name, tilt_line, "TILT",
-                    "external TILT file '" + file + "' must be a plain file name in the IES file's folder");
+                    "external TILT file '" + detail::excerpt(file, 200) + "' must be a plain file name in the IES file's folder");
     if (options.base_dir.empty())
       throw_at_line(name, tilt_line, "TILT",
-                    "external TILT file '" + file + "' cannot be resolved: no folder given (read from memory)");
+                    "external TILT file '" + detail::excerpt(file, 200) + "' cannot be resolved: no folder given (read from memory)");
     const std::string path = options.base_dir + "/" + file;
+    // A symbolic link could still lead out of the folder: the resolved file must live in it.
+    std::error_code ec;
+    const auto real_dir = std::filesystem::canonical(options.base_dir, ec);
+    const auto real_file = ec ? std::filesystem::path() : std::filesystem::canonical(path, ec);
+    if (ec)
+      throw_at_line(name, tilt_line, "TILT", "external TILT file '" + detail::excerpt(file, 200) + "' not found");
+    if (real_file.parent_path() != real_dir)
+      throw_at_line(name, tilt_line, "TILT",
+                    "external TILT file '" + detail::excerpt(file, 200) + "' resolves outside the IES file's folder");
     std::string tilt_text;
     try {
       tilt_text = read_file_bounded(path, 1u << 20);
@@ -210,7 +220,7 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
   p.candela_multiplier = multiplier;
 
   LampSet lamp;
-  lamp.count = static_cast<int>(n_lamps);
+  lamp.count = static_cast<int>(std::max<long>(n_lamps, 1));
   if (const Keyword* k = p.find_keyword("LAMP")) lamp.type = k->value;
   lamp.watts = p.input_watts;
   if (lumens == -1.0) {

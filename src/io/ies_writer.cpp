@@ -48,15 +48,6 @@ void write_keyword(std::ostringstream& out, const std::string& key, const std::s
   } while (start != std::string::npos);
 }
 
-/// Valid LM-63-2019 file generation types (Table 2): 1.00000 + {0.00001 | 0.00010 | lab digits}.
-bool is_file_generation_type(double v) {
-  static const double kValid[] = {1.00001, 1.00010, 1.00000, 1.00100, 1.01000, 1.01100,
-                                  1.10000, 1.10100, 1.11000, 1.11100};
-  for (double k : kValid)
-    if (std::abs(v - k) < 5e-6) return true;
-  return false;
-}
-
 }  // namespace
 
 std::string format_ies(const Photometry& p, const IesWriteOptions& options) {
@@ -66,16 +57,31 @@ std::string format_ies(const Photometry& p, const IesWriteOptions& options) {
                         std::to_string(p.horizontal_deg.size()) + " x " + std::to_string(nv) + " angles");
   for (double c : p.candela)
     if (!std::isfinite(c)) fail("candela", "non-finite value");
+  for (const auto* angles : {&p.vertical_deg, &p.horizontal_deg})
+    for (std::size_t i = 0; i < angles->size(); ++i)
+      if (!std::isfinite((*angles)[i]) || (i > 0 && !((*angles)[i] > (*angles)[i - 1])))
+        fail(angles == &p.vertical_deg ? "vertical angle" : "horizontal angle",
+             "angles must be finite and strictly increasing");
+  double first = 0, last = 0;
+  if (p.type == PhotometricType::C && stored_range(p.symmetry, first, last) &&
+      (std::abs(p.horizontal_deg.front() - first) > 1e-9 || std::abs(p.horizontal_deg.back() - last) > 1e-9))
+    fail("horizontal angle", std::string("stored planes do not span the range of symmetry ") + to_string(p.symmetry));
   const int digits = options.significant_digits;
 
   // Horizontal planes as IES states them: a Type C table with no symmetry must run 0..360.
   AngleTable table = stored_table(p);
-  if (p.type == PhotometricType::C && p.symmetry == Symmetry::none) {
+  Symmetry symmetry = p.symmetry;
+  if (p.type == PhotometricType::C && symmetry == Symmetry::plane_c90_c270 && options.expand_c90_c270) {
+    table = expand(table, symmetry);  // 0..<360, closed to 360 below
+    symmetry = Symmetry::none;
+  }
+  if (p.type == PhotometricType::C && symmetry == Symmetry::none) {
     if (std::abs(table.horizontal_deg.front()) > 1e-9)
       fail("horizontal angle", "a Type C table without symmetry must start at C0");
     if (std::abs(table.horizontal_deg.back() - 360.0) > 1e-9) {
       table.horizontal_deg.push_back(360.0);  // close the circle with a copy of C0
-      table.candela.insert(table.candela.end(), p.candela.begin(), p.candela.begin() + static_cast<long>(nv));
+      const std::vector<double> c0(table.candela.begin(), table.candela.begin() + static_cast<long>(nv));
+      table.candela.insert(table.candela.end(), c0.begin(), c0.end());
     }
   }
   const std::size_t nh = table.horizontal_deg.size();
@@ -99,8 +105,8 @@ std::string format_ies(const Photometry& p, const IesWriteOptions& options) {
   if (!p.ldt.luminaire_number.empty()) ensure("LUMCAT", p.ldt.luminaire_number);
   if (!p.lamp_sets.empty() && !p.lamp_sets.front().type.empty()) ensure("LAMP", p.lamp_sets.front().type);
   if (options.version == IesVersion::lm63_2019 && !p.source.version.empty() && p.source.version != file_format::kIes2019)
-    ensure("FILEGENINFO", "Converted by lumx " + std::string(kLibraryVersion) + " from " + p.source.format + " " +
-                              p.source.version);
+    ensure("FILEGENINFO", "Converted by lumx " + std::string(kLibraryVersion) + " from " +
+                              (p.source.format == "IES" ? "IES " + p.source.version : p.source.format));
   for (const auto& k : kw) write_keyword(out, k.name, k.value);
 
   if (p.tilt) {
@@ -124,7 +130,7 @@ std::string format_ies(const Photometry& p, const IesWriteOptions& options) {
       << detail::format_number(p.opening.height_m * from_m, digits) << kEol;
   double second = p.ies_second_factor;
   if (options.version == IesVersion::lm63_2019) {
-    if (p.source.version != file_format::kIes2019 || !is_file_generation_type(second)) second = 1.00001;
+    if (p.source.version != file_format::kIes2019 || !is_lm63_2019_file_generation_type(second)) second = 1.00001;
   } else if (p.source.version == file_format::kIes2019) {
     second = 1.0;  // "future use" in 2002
   }

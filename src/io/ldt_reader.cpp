@@ -121,7 +121,7 @@ double LdtParser::parse_real(std::string_view tok, int line, const std::string& 
   std::string buf;
   if (comma != std::string_view::npos) {
     if (tok.find(',', comma + 1) != std::string_view::npos || tok.find('.') != std::string_view::npos)
-      fail(line, field, "'" + std::string(tok) + "' mixes decimal and grouping separators; ambiguous number");
+      fail(line, field, "'" + detail::excerpt(tok) + "' mixes decimal and grouping separators; ambiguous number");
     std::string_view before = tok.substr(0, comma), after = tok.substr(comma + 1);
     if (!before.empty() && (before.front() == '-' || before.front() == '+')) before.remove_prefix(1);
     const bool three_after = after.size() == 3 && std::all_of(after.begin(), after.end(), is_digit);
@@ -129,14 +129,14 @@ double LdtParser::parse_real(std::string_view tok, int line, const std::string& 
                               std::all_of(before.begin(), before.end(), is_digit);
     if (three_after && group_before)
       fail(line, field,
-           "'" + std::string(tok) +
+           "'" + detail::excerpt(tok) +
                "' is ambiguous: the comma may be a decimal comma or a thousands separator");
     buf.assign(tok.data(), tok.size());
     buf[comma] = '.';
     tok = buf;
   }
   double v = 0;
-  if (!detail::parse_number(tok, v)) fail(line, field, "'" + std::string(tok) + "' is not a finite number");
+  if (!detail::parse_number(tok, v)) fail(line, field, "'" + detail::excerpt(tok) + "' is not a finite number");
   return v;
 }
 
@@ -146,7 +146,7 @@ double LdtParser::parse_real(std::string_view tok, int line, const std::string& 
 int LdtParser::parse_int(std::string_view tok, int line, const std::string& field) const {
   tok = detail::trim(tok);
   if (tok.empty()) fail(line, field, "empty, expected an integer");
-  const std::string shown(tok);
+  const std::string shown = detail::excerpt(tok);
   bool negative = false;
   if (tok.front() == '-' || tok.front() == '+') {
     negative = tok.front() == '-';
@@ -233,8 +233,8 @@ Photometry LdtParser::parse() {
   if (dc < 0) fail(kDc, "Dc", "C-plane spacing " + fmt(dc) + " is negative");
   const int ng = int_field(kNg, "Ng");
   const int ng_limit = static_cast<int>(std::min<std::size_t>(kMaxGamma, opt_.limits.max_angles));
-  if (ng < 1 || ng > ng_limit)
-    fail(kNg, "Ng", "number of gamma angles " + std::to_string(ng) + " is outside 1.." + std::to_string(ng_limit));
+  if (ng < 2 || ng > ng_limit)  // one gamma angle describes no solid angle: no flux, no interpolation
+    fail(kNg, "Ng", "number of gamma angles " + std::to_string(ng) + " is outside 2.." + std::to_string(ng_limit));
   const double dg = real_field(kDg, "Dg");
   if (dg < 0) fail(kDg, "Dg", "gamma spacing " + fmt(dg) + " is negative");
 

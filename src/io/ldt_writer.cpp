@@ -33,16 +33,9 @@ namespace {
   throw Error(std::move(d));
 }
 
-// Shortest %g-style rendering with `digits` significant digits, locale-independent, no trailing zeros.
-std::string num(double v, int digits) {
-  if (v == 0) return "0";  // also folds -0
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
-  if (r.ec != std::errc()) return "0";  // cannot happen with 64 bytes
-  std::string s(buf, r.ptr);
-  if (s == "-0") s = "0";
-  return s;
-}
+// Plain decimals with `digits` significant digits (never exponent notation, which EULUMDAT readers in
+// the wild do not expect).
+std::string num(double v, int digits) { return detail::format_number(v, digits); }
 
 // Text fields must stay on one line: line breaks (e.g. from joined IES [MORE] keywords) become blanks.
 std::string one_line(const std::string& s) {

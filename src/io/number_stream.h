@@ -39,7 +39,7 @@ class NumberStream {
     last_line_ = t.line;
     double v = 0;
     if (!parse_number(t.text, v))
-      throw_at_line(file_, t.line, field, "expected a finite number, found '" + std::string(t.text.substr(0, 40)) + "'");
+      throw_at_line(file_, t.line, field, "expected a finite number, found '" + excerpt(t.text) + "'");
     return v;
   }
 
@@ -78,7 +78,7 @@ class NumberStream {
       double v = 0;
       if (!parse_number(t.text, v))  // the field name is only built on failure (hot path)
         throw_at_line(file_, t.line, field + " " + std::to_string(i + 1) + " of " + std::to_string(n),
-                      "expected a finite number, found '" + std::string(t.text.substr(0, 40)) + "'");
+                      "expected a finite number, found '" + excerpt(t.text) + "'");
       out.push_back(v);
       if (lines) lines->push_back(static_cast<std::uint32_t>(last_line_));
     }

@@ -36,6 +36,10 @@ bool parse_number(std::string_view token, double& out);
 /// locale-independent, never "-0". Used by the writers.
 std::string format_number(double v, int significant_digits);
 
+/// At most `max_bytes` of `s`, made valid UTF-8 (for quoting file content in diagnostics, which end up
+/// in JSON).
+std::string excerpt(std::string_view s, std::size_t max_bytes = 40);
+
 /// A token of a numeric stream with the line it came from.
 struct Token {
   std::string_view text;

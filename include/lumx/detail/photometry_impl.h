@@ -86,12 +86,20 @@ inline double LuminousOpening::max_dimension_m() const {
 inline double TiltTable::multiplier_at(double tilt_deg) const {
   const std::size_t n = std::min(angles_deg.size(), multipliers.size());
   if (n == 0) return 1.0;
-  if (n == 1 || tilt_deg <= angles_deg[0]) return multipliers[0];
+  if (n == 1 || !(tilt_deg > angles_deg[0])) return multipliers[0];  // also NaN: never index past the end
   if (tilt_deg >= angles_deg[n - 1]) return multipliers[n - 1];
   const auto it = std::upper_bound(angles_deg.begin(), angles_deg.begin() + static_cast<long>(n), tilt_deg);
   const std::size_t i = static_cast<std::size_t>(it - angles_deg.begin()) - 1;
   const double t = (tilt_deg - angles_deg[i]) / (angles_deg[i + 1] - angles_deg[i]);
   return (1 - t) * multipliers[i] + t * multipliers[i + 1];
+}
+
+inline bool is_lm63_2019_file_generation_type(double v) {
+  static const double kValid[] = {1.00001, 1.00010, 1.00000, 1.00100, 1.01000,
+                                  1.01100, 1.10000, 1.10100, 1.11000, 1.11100};
+  for (double k : kValid)
+    if (std::abs(v - k) < 5e-6) return true;
+  return false;
 }
 
 inline double Photometry::rated_lamp_flux_lm() const {

@@ -12,6 +12,7 @@
 #include <lumx/photometry.h>
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -21,7 +22,7 @@ enum class PhotometryFormat { ies, ldt };
 
 /// Limits that protect readers from absurd or hostile files. A file exceeding one is rejected.
 struct ReadLimits {
-  std::size_t max_file_bytes = 64u << 20;  ///< 64 MiB: the largest real IES file is ~2 MB
+  std::size_t max_file_bytes = 16u << 20;  ///< 16 MiB: the largest real files are ~2 MB
   std::size_t max_angles = 3601;           ///< per axis (0.05 degree steps over 180 degrees)
   std::size_t max_lamp_sets = 20;          ///< EULUMDAT allows at most 20 lamp sets
 };
@@ -39,6 +40,9 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
 /// Parses EULUMDAT text. `name` is used in diagnostics.
 Photometry read_ldt(std::string_view text, const std::string& name, const ReadOptions& options = {});
 
+/// Format named by a file name's extension (.ies, .ldt, case-insensitive), if any.
+std::optional<PhotometryFormat> format_from_extension(const std::string& path);
+
 /// Format from a file name's extension (.ies, .ldt, case-insensitive), else by sniffing `head` (the
 /// file's first bytes): an IES version line or a TILT= line means IES, otherwise EULUMDAT if the first
 /// lines have its numeric layout. Throws lumx::Error if neither fits.
@@ -53,6 +57,12 @@ enum class IesVersion { lm63_2002, lm63_2019 };
 struct IesWriteOptions {
   IesVersion version = IesVersion::lm63_2019;
   int significant_digits = 7;  ///< candela and angle precision
+  /// C90-C270 symmetry is legal as the horizontal range 90..270 (LM-63-1995 on), and written so by
+  /// default (write-then-read gives back the same model). Common readers mishandle it, though (Blender
+  /// shifts it by 90 degrees, others require the last angle to be 0, 90, 180 or 360; formats.md §1.4):
+  /// set this to write such data expanded to 0..360 instead, which changes no intensity. The `lumx
+  /// convert` tool does so unless asked not to.
+  bool expand_c90_c270 = false;
 };
 
 struct LdtWriteOptions {
@@ -60,8 +70,9 @@ struct LdtWriteOptions {
 };
 
 /// IES text for `p` (Type A, B or C). The stored subset is written with the range that states its
-/// symmetry; candela are written as absolute cd with multiplier 1. Throws lumx::Error if `p` cannot be
-/// expressed (e.g. inconsistent table sizes).
+/// symmetry (C90-C270: see IesWriteOptions); candela are written as absolute cd with multiplier 1.
+/// Throws lumx::Error if `p` cannot be expressed (inconsistent table sizes, non-finite values, angles
+/// not increasing, or a stored range that contradicts the symmetry).
 std::string format_ies(const Photometry& p, const IesWriteOptions& options = {});
 /// EULUMDAT text for `p`. Type C only (convert A/B with to_type_c first); intensities written in cd/klm.
 std::string format_ldt(const Photometry& p, const LdtWriteOptions& options = {});
