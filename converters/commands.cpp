@@ -37,12 +37,6 @@ lumx::Photometry load(const std::string& path, std::vector<lumx::Diagnostic>* wa
   return lumx::read_photometry(path, o);
 }
 
-std::string title_of(const lumx::Photometry& p) {
-  if (!p.ldt.luminaire_name.empty()) return p.ldt.luminaire_name;
-  if (const auto* k = p.find_keyword("LUMINAIRE")) return k->value.substr(0, k->value.find('\n'));
-  return std::filesystem::path(p.source.file).filename().string();
-}
-
 json spread_json(const lumx::Spread& s) {
   return {{"beam_deg", s.beam_deg},
           {"field_deg", s.field_deg},
@@ -232,7 +226,7 @@ int run_plot(const PlotArgs& a) {
   return guarded(a.file, [&] {
     const lumx::Photometry p = load(a.file);
     lumx::PolarPlotOptions o;
-    o.title = a.title.empty() ? title_of(p) : a.title;
+    o.title = a.title;  // empty: the diagram's own default (luminaire name, else file name)
     o.size_px = a.size_px;
     o.force_cd = a.force_cd;
     lumx::write_polar_plot(p, a.out, o);
