@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -107,4 +108,33 @@ TEST(Robustness, AtomicWriteKeepsPermissionsAndLeavesNoTemporary) {
   EXPECT_EQ(n, 1u);
   EXPECT_THROW(write_file_atomically((d / "missing" / "y.ies").string(), "z"), Error);
   fs::remove_all(d);
+}
+
+namespace {
+long peak_rss_kb() {
+  struct rusage ru {};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_maxrss;
+}
+}  // namespace
+
+TEST(Robustness, HugeFilesAreReadInMemoryBoundedByTheirSize) {
+  // 14 MiB of one number per line: the readers keep only the values the header implies, and never a
+  // per-line or per-token index of the whole file (which cost ~25x the file size before).
+  const std::size_t n = 7u << 20;
+  std::string ies = std::string(kTable);
+  std::string ldt = lumx_test::read_text(lumx_test::data_dir() / "photometry/Wei-Lim+lighting/ldt_min_example.ldt");
+  ies.reserve(ies.size() + 2 * n);
+  ldt.reserve(ldt.size() + 2 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    ies += "1\n";
+    ldt += "1\n";
+  }
+  const long before = peak_rss_kb();
+  ReadOptions quiet;
+  quiet.warnings = [](const Diagnostic&) {};
+  EXPECT_NO_THROW(read_ies(ies, "big.ies", quiet));  // trailing values are a warning
+  EXPECT_NO_THROW(read_ldt(ldt, "big.ldt", quiet));
+  const long grown_kb = peak_rss_kb() - before;
+  EXPECT_LT(grown_kb * 1024.0, 2.0 * static_cast<double>(ies.size())) << grown_kb << " kB";
 }

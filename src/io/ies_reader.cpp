@@ -90,7 +90,6 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
     throw Error(Diagnostic{Severity::error, name, 0, 0, "file size",
                            "file is " + std::to_string(text.size()) + " bytes, above the limit of " +
                                std::to_string(options.limits.max_file_bytes)});
-  const std::vector<Line> lines = detail::split_lines(text);
   const NumberStream::Warn warn = [&](int line, const std::string& field, const std::string& msg) {
     if (options.warnings) options.warnings(Diagnostic{Severity::warning, name, line, -1, field, msg});
   };
@@ -100,21 +99,30 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
   p.source.format = "IES";
 
   // ---- version line and keywords, up to TILT= ----
-  std::size_t li = 0;
-  while (li < lines.size() && trim(lines[li].text).empty()) ++li;
-  if (li == lines.size()) throw_at_line(name, 1, "version", "empty file");
+  // Real headers are a few dozen lines; a file with no TILT= line among its first kMaxHeaderLines is
+  // not read further (and never kept whole as keyword text).
+  constexpr int kMaxHeaderLines = 10000;
+  detail::LineCursor cursor(text);
+  Line line;
+  bool any = false;
+  while ((any = cursor.next(line)) && trim(line.text).empty()) {
+  }
+  if (!any) throw_at_line(name, 1, "version", "empty file");
   bool has_version = false;
-  p.source.version = version_of_first_line(lines[li].text, has_version, warn, lines[li].number);
-  if (has_version) ++li;
+  p.source.version = version_of_first_line(line.text, has_version, warn, line.number);
+  bool have_line = !has_version;  // a 1986 file's first line is header text, to be read below
   std::string_view tilt_value;
   bool found_tilt = false;
   int tilt_line = 0;
-  for (; li < lines.size(); ++li) {
-    const std::string_view raw = lines[li].text;
+  while (have_line || cursor.next(line)) {
+    have_line = false;
+    if (line.number > kMaxHeaderLines)
+      throw_at_line(name, line.number, "TILT", "no 'TILT=' line within the first " +
+                                                   std::to_string(kMaxHeaderLines) + " lines");
+    const std::string_view raw = line.text;
     if (is_tilt_line(raw, tilt_value)) {
       found_tilt = true;
-      tilt_line = lines[li].number;
-      ++li;
+      tilt_line = line.number;
       break;
     }
     const std::string_view t = trim(raw);
@@ -126,7 +134,7 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
     if (t.front() == '[') {
       const std::size_t close = t.find(']');
       if (close == std::string_view::npos) {
-        warn(lines[li].number, "keyword", "no closing ']'; line kept as [OTHER] text");
+        warn(line.number, "keyword", "no closing ']'; line kept as [OTHER] text");
         p.keywords.push_back({"OTHER", detail::to_utf8(t)});
         continue;
       }
@@ -134,7 +142,7 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
       std::string value = detail::to_utf8(trim(t.substr(close + 1)));
       if (key == "MORE") {
         if (p.keywords.empty()) {
-          warn(lines[li].number, "keyword", "[MORE] without a preceding keyword; kept as [OTHER]");
+          warn(line.number, "keyword", "[MORE] without a preceding keyword; kept as [OTHER]");
           p.keywords.push_back({"OTHER", value});
         } else {
           p.keywords.back().value += "\n" + value;
@@ -144,16 +152,16 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
       }
       continue;
     }
-    warn(lines[li].number, "keyword", "line is not a [KEYWORD]; kept as continuation of the previous one");
+    warn(line.number, "keyword", "line is not a [KEYWORD]; kept as continuation of the previous one");
     if (p.keywords.empty()) p.keywords.push_back({"OTHER", detail::to_utf8(t)});
     else p.keywords.back().value += "\n" + detail::to_utf8(t);
   }
   if (!found_tilt)
-    throw_at_line(name, lines.empty() ? 1 : lines.back().number, "TILT",
+    throw_at_line(name, std::max(1, cursor.number() - 1), "TILT",
                   "no line starting with 'TILT=' (every LM-63 file has one before the photometric data)");
 
-  const std::vector<detail::Token> tokens = detail::tokenize(lines, li);
-  NumberStream in(tokens, name, tilt_line);
+  // The numbers start on the line after TILT= (the cursor stands there).
+  NumberStream in(text, cursor.offset(), cursor.number(), name);
 
   // ---- TILT ----
   const std::string tilt_upper = upper(tilt_value);
@@ -186,9 +194,7 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
     } catch (const Error& e) {
       throw_at_line(name, tilt_line, "TILT", "external TILT file: " + e.diagnostic().message);
     }
-    const std::vector<Line> tl = detail::split_lines(tilt_text);
-    const std::vector<detail::Token> tt = detail::tokenize(tl, 0);
-    NumberStream tin(tt, path, 1);
+    NumberStream tin(tilt_text, detail::LineCursor(tilt_text).offset(), 1, path);
     p.tilt = read_tilt_block(tin, options.limits);
     p.tilt->source = file;
   }

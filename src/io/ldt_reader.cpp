@@ -56,7 +56,7 @@ bool is_digit(char c) { return c >= '0' && c <= '9'; }
 class LdtParser {
  public:
   LdtParser(std::string_view text, const std::string& name, const ReadOptions& options)
-      : text_(text), name_(name), opt_(options) {}
+      : text_(text), name_(name), opt_(options), cursor_(text) {}
 
   Photometry parse();
 
@@ -78,6 +78,7 @@ class LdtParser {
 
   // The trimmed text of header line `n` (1-based); error if the file ends before it.
   std::string_view line_text(int n, const std::string& field) const {
+    if (n >= 1) ensure_lines(static_cast<std::size_t>(n));
     if (n < 1 || static_cast<std::size_t>(n) > lines_.size())
       fail(n, field, "file ends before this field (line " + std::to_string(n) + "; the file has " +
                          std::to_string(lines_.size()) + " lines)");
@@ -101,7 +102,15 @@ class LdtParser {
   std::string_view text_;
   const std::string& name_;
   const ReadOptions& opt_;
-  std::vector<detail::Line> lines_;
+  // Header lines are split on demand, so only the (at most ~160) header lines are ever stored; the
+  // numeric part is tokenised straight from the cursor.
+  void ensure_lines(std::size_t n) const {
+    detail::Line l;
+    while (lines_.size() < n && cursor_.next(l)) lines_.push_back(l);
+  }
+
+  mutable detail::LineCursor cursor_;
+  mutable std::vector<detail::Line> lines_;
   std::vector<detail::Token> tokens_;
   std::size_t extra_tokens_ = 0;  // tokens beyond `keep`
   int first_extra_line_ = 0;
@@ -173,8 +182,11 @@ int LdtParser::parse_int(std::string_view tok, int line, const std::string& fiel
 }
 
 void LdtParser::tokenize_numeric(std::size_t first_index, std::size_t keep) {
-  for (std::size_t li = first_index; li < lines_.size(); ++li) {
-    const std::string_view s = lines_[li].text;
+  ensure_lines(first_index);
+  detail::Line next;
+  for (std::size_t li = first_index; li < lines_.size() || cursor_.next(next); ++li) {
+    const detail::Line& line = li < lines_.size() ? lines_[li] : next;
+    const std::string_view s = line.text;
     std::size_t i = 0;
     auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\0' || c == '\f' || c == '\v'; };
     while (i < s.size()) {
@@ -183,9 +195,9 @@ void LdtParser::tokenize_numeric(std::size_t first_index, std::size_t keep) {
       while (i < s.size() && !blank(s[i])) ++i;
       if (i == b) continue;
       if (tokens_.size() < keep) {
-        tokens_.push_back({s.substr(b, i - b), lines_[li].number});
+        tokens_.push_back({s.substr(b, i - b), line.number});
       } else if (extra_tokens_++ == 0) {
-        first_extra_line_ = lines_[li].number;
+        first_extra_line_ = line.number;
       }
     }
   }
@@ -201,7 +213,6 @@ Photometry LdtParser::parse() {
                 std::to_string(opt_.limits.max_file_bytes) + " bytes";
     throw Error(std::move(d));
   }
-  lines_ = detail::split_lines(text_);
 
   Photometry p;
   p.type = PhotometricType::C;
@@ -326,6 +337,7 @@ Photometry LdtParser::parse() {
   const std::size_t numeric_start = static_cast<std::size_t>(kLampSetCount + 6 * nsets);  // 0-based index
   const std::size_t ncs = static_cast<std::size_t>(mc), ngs = static_cast<std::size_t>(ng);
   const std::size_t needed = 10 + ncs + ngs + nstored * ngs;  // <= 10 + 721 + 361 + 721 * 361
+  ensure_lines(numeric_start);
   tokenize_numeric(std::min(numeric_start, lines_.size()), needed);
   std::size_t pos = 0;
   // Field name of the k-th value of the numeric stream, for messages.

@@ -7,6 +7,23 @@
 LUMX_NAMESPACE_BEGIN
 namespace detail {
 
+LineCursor::LineCursor(std::string_view text) : text_(text) {
+  if (text.size() >= 3 && static_cast<unsigned char>(text[0]) == 0xEF &&
+      static_cast<unsigned char>(text[1]) == 0xBB && static_cast<unsigned char>(text[2]) == 0xBF)
+    pos_ = 3;
+}
+
+bool LineCursor::next(Line& line) {
+  if (pos_ >= text_.size()) return false;
+  const std::size_t b = pos_;
+  std::size_t e = b;
+  while (e < text_.size() && text_[e] != '\n' && text_[e] != '\r') ++e;
+  line = {text_.substr(b, e - b), number_++};
+  pos_ = e;
+  if (pos_ < text_.size()) pos_ += (text_[pos_] == '\r' && pos_ + 1 < text_.size() && text_[pos_ + 1] == '\n') ? 2 : 1;
+  return true;
+}
+
 std::vector<Line> split_lines(std::string_view text) {
   if (text.size() >= 3 && static_cast<unsigned char>(text[0]) == 0xEF &&
       static_cast<unsigned char>(text[1]) == 0xBB && static_cast<unsigned char>(text[2]) == 0xBF)
@@ -111,24 +128,6 @@ std::string excerpt(std::string_view s, std::size_t max_bytes) {
   return to_utf8(s.substr(0, max_bytes));
 }
 
-std::vector<Token> tokenize(const std::vector<Line>& lines, std::size_t first_line) {
-  std::vector<Token> tokens;
-  for (std::size_t li = first_line; li < lines.size(); ++li) {
-    const std::string_view s = lines[li].text;
-    std::size_t i = 0;
-    while (i < s.size()) {
-      while (i < s.size() && (s[i] == ' ' || s[i] == '\t' || s[i] == ',' || s[i] == '\0' || s[i] == '\f' ||
-                              s[i] == '\v'))
-        ++i;
-      const std::size_t b = i;
-      while (i < s.size() && !(s[i] == ' ' || s[i] == '\t' || s[i] == ',' || s[i] == '\0' || s[i] == '\f' ||
-                               s[i] == '\v'))
-        ++i;
-      if (i > b) tokens.push_back({s.substr(b, i - b), lines[li].number});
-    }
-  }
-  return tokens;
-}
 
 }  // namespace detail
 LUMX_NAMESPACE_END

@@ -17,6 +17,24 @@ struct Line {
   int number = 0;
 };
 
+/// Reads lines one at a time (CRLF, LF or lone CR; a UTF-8 BOM at the start is skipped), so a reader
+/// that needs only a file's first lines does not split all of it.
+class LineCursor {
+ public:
+  explicit LineCursor(std::string_view text);
+  /// The next line, or false at the end of the text.
+  bool next(Line& line);
+  /// Byte offset and number of the line that next() would return.
+  std::size_t offset() const { return pos_; }
+  int number() const { return number_; }
+  std::string_view text() const { return text_; }
+
+ private:
+  std::string_view text_;
+  std::size_t pos_ = 0;
+  int number_ = 1;
+};
+
 /// Splits on CRLF, LF or lone CR. A UTF-8 byte-order mark at the start is dropped. A final line
 /// without a terminator is kept; trailing empty lines are kept too (callers skip them).
 std::vector<Line> split_lines(std::string_view text);
@@ -46,8 +64,6 @@ struct Token {
   int line = 0;
 };
 
-/// Splits lines into tokens separated by blanks, tabs or commas (LM-63-2002 delimiters).
-std::vector<Token> tokenize(const std::vector<Line>& lines, std::size_t first_line);
 
 }  // namespace detail
 LUMX_NAMESPACE_END
