@@ -1,0 +1,50 @@
+// libFuzzer target: any bytes through both readers, validation, the intensity table and both writers.
+// Only lumx::Error may come out of a reader; a table that was read must survive everything after it.
+//
+//   cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DLUMX_BUILD_FUZZERS=ON -DLUMX_BUILD_CLI=OFF \
+//         -DLUMX_BUILD_TESTS=OFF -DLUMX_BUILD_BENCH=OFF && cmake --build build-fuzz
+//   build-fuzz/tests/fuzz/lumx_fuzz_photometry tests/data/bad tests/data/photometry/*/ -max_total_time=300
+#include <lumx/intensity_table.h>
+#include <lumx/io/photometry_io.h>
+#include <lumx/photometric_metrics.h>
+#include <lumx/validate.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <string_view>
+
+namespace {
+
+void exercise(const lumx::Photometry& p) {
+  (void)lumx::validate(p);
+  try {
+    const lumx::PhotometricSummary s = lumx::summarize(p);
+    if (!(s.flux_lm >= 0) && p.candela.size() > 0) {
+      bool negative = false;
+      for (double c : p.candela) negative = negative || c < 0;
+      if (!negative) std::abort();  // non-negative table, NaN or negative flux: a bug
+    }
+  } catch (const std::invalid_argument&) {
+  }
+  try {
+    (void)lumx::read_ies(lumx::format_ies(p), "rt.ies");
+    if (p.type == lumx::PhotometricType::C) (void)lumx::read_ldt(lumx::format_ldt(p), "rt.ldt");
+  } catch (const lumx::Error&) {
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  lumx::ReadOptions o;
+  o.warnings = [](const lumx::Diagnostic&) {};
+  for (int format = 0; format < 2; ++format) {
+    try {
+      const lumx::Photometry p = format == 0 ? lumx::read_ies(text, "fuzz.ies", o) : lumx::read_ldt(text, "fuzz.ldt", o);
+      exercise(p);
+    } catch (const lumx::Error&) {
+    }
+  }
+  return 0;
+}
