@@ -215,7 +215,7 @@ int run_convert(const ConvertArgs& a) {
     w.ies.significant_digits = a.digits;
     w.ies.expand_c90_c270 = !a.keep_c90_c270;
     w.ldt.significant_digits = a.digits;
-    const double f0 = lumx::summarize(p).flux_lm;  // before writing: a failure must not replace the output
+    const double f0 = lumx::IntensityTable(p).flux_lm();  // before writing: a failure must not replace the output
     lumx::write_photometry(p, a.out, w);
     std::printf("%s -> %s (flux %.2f lm)\n", a.in.c_str(), a.out.c_str(), f0);
     return 0;

@@ -2,6 +2,8 @@
 #include <lumx/photometric_metrics.h>
 #include <lumx/validate.h>
 
+#include "io/text_scanner.h"
+
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -9,11 +11,7 @@
 LUMX_NAMESPACE_BEGIN
 namespace {
 
-std::string num(double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
+std::string num(double v) { return detail::format_number(v, 6); }
 
 }  // namespace
 

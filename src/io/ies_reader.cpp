@@ -9,6 +9,7 @@
 #include <lumx/io/photometry_io.h>
 #include <lumx/symmetry.h>
 
+#include "io/intensity_checks.h"
 #include "io/number_stream.h"
 #include "io/text_scanner.h"
 
@@ -27,6 +28,8 @@ using detail::trim;
 bool starts_with(std::string_view s, std::string_view prefix) {
   return s.size() >= prefix.size() && s.substr(0, prefix.size()) == prefix;
 }
+
+std::string num(double v) { return detail::format_number(v, 10); }
 
 std::string upper(std::string_view s) {
   std::string u(s);
@@ -236,7 +239,7 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
   } else {
     p.absolute = true;
     warn(in.last_line(), "lumens per lamp",
-         "value " + std::to_string(lumens) + " is neither -1 nor positive; read as absolute photometry");
+         "value " + num(lumens) + " is neither -1 nor positive; read as absolute photometry");
   }
   p.lamp_sets.push_back(lamp);
 
@@ -244,34 +247,33 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
   const std::size_t nvs = static_cast<std::size_t>(nv), nhs = static_cast<std::size_t>(nh);
   p.vertical_deg = in.next_values(nvs, "vertical angle", &p.source.vertical_lines);
   p.horizontal_deg = in.next_values(nhs, "horizontal angle", &p.source.horizontal_lines);
-  for (std::size_t i = 1; i < nvs; ++i)
-    if (!(p.vertical_deg[i] > p.vertical_deg[i - 1]))
-      throw_at_line(name, static_cast<int>(p.source.vertical_lines[i]), "vertical angle",
-                    "angles must strictly increase (value " + std::to_string(i + 1) + " is " +
-                        std::to_string(p.vertical_deg[i]) + " after " + std::to_string(p.vertical_deg[i - 1]) + ")");
-  for (std::size_t i = 1; i < nhs; ++i)
-    if (!(p.horizontal_deg[i] > p.horizontal_deg[i - 1]))
-      throw_at_line(name, static_cast<int>(p.source.horizontal_lines[i]), "horizontal angle",
-                    "angles must strictly increase (value " + std::to_string(i + 1) + " is " +
-                        std::to_string(p.horizontal_deg[i]) + " after " +
-                        std::to_string(p.horizontal_deg[i - 1]) + ")");
+  auto require_increasing = [&](const std::vector<double>& a, const std::vector<std::uint32_t>& lines,
+                                const char* field) {
+    for (std::size_t i = 1; i < a.size(); ++i)
+      if (!(a[i] > a[i - 1]))
+        throw_at_line(name, static_cast<int>(lines[i]), field,
+                      "angles must strictly increase (value " + std::to_string(i + 1) + " is " + num(a[i]) +
+                          " after " + num(a[i - 1]) + ")");
+  };
+  require_increasing(p.vertical_deg, p.source.vertical_lines, "vertical angle");
+  require_increasing(p.horizontal_deg, p.source.horizontal_lines, "horizontal angle");
   const double vlo = p.type == PhotometricType::C ? 0.0 : -90.0, vhi = p.type == PhotometricType::C ? 180.0 : 90.0;
   if (p.vertical_deg.front() < vlo - 1e-9 || p.vertical_deg.back() > vhi + 1e-9)
     throw_at_line(name, static_cast<int>(p.source.vertical_lines.front()), "vertical angle",
-                  "range " + std::to_string(p.vertical_deg.front()) + ".." + std::to_string(p.vertical_deg.back()) +
-                      " outside " + std::to_string(vlo) + ".." + std::to_string(vhi) + " for Type " +
+                  "range " + num(p.vertical_deg.front()) + ".." + num(p.vertical_deg.back()) +
+                      " outside " + num(vlo) + ".." + num(vhi) + " for Type " +
                       to_string(p.type));
   const double hlo = p.type == PhotometricType::C ? 0.0 : -180.0, hhi = p.type == PhotometricType::C ? 360.0 : 180.0;
   if (p.horizontal_deg.front() < hlo - 1e-9 || p.horizontal_deg.back() > hhi + 1e-9)
     throw_at_line(name, static_cast<int>(p.source.horizontal_lines.front()), "horizontal angle",
-                  "range " + std::to_string(p.horizontal_deg.front()) + ".." +
-                      std::to_string(p.horizontal_deg.back()) + " outside " + std::to_string(hlo) + ".." +
-                      std::to_string(hhi) + " for Type " + to_string(p.type));
+                  "range " + num(p.horizontal_deg.front()) + ".." +
+                      num(p.horizontal_deg.back()) + " outside " + num(hlo) + ".." +
+                      num(hhi) + " for Type " + to_string(p.type));
   const auto sym = symmetry_from_ies_range(p.type, p.horizontal_deg.front(), p.horizontal_deg.back(), nhs);
   if (!sym)
     throw_at_line(name, static_cast<int>(p.source.horizontal_lines.front()), "horizontal angle",
-                  "range " + std::to_string(p.horizontal_deg.front()) + ".." +
-                      std::to_string(p.horizontal_deg.back()) +
+                  "range " + num(p.horizontal_deg.front()) + ".." +
+                      num(p.horizontal_deg.back()) +
                       " states no LM-63 symmetry (Type C: a single 0, 0..90, 0..180, 90..270 or 0..360)");
   p.symmetry = *sym;
   if (p.type == PhotometricType::C && !(p.vertical_deg.front() == 0.0 || p.vertical_deg.front() == 90.0) )
@@ -281,7 +283,6 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
   // ---- candela ----
   const std::size_t ncd = nvs * nhs;
   p.candela = in.next_values(ncd, "candela value", &p.source.candela_lines);
-  double peak = 0;
   for (std::size_t i = 0; i < ncd; ++i) {
     double& c = p.candela[i];
     c *= multiplier;
@@ -289,23 +290,16 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
       throw_at_line(name, static_cast<int>(p.source.candela_lines[i]),
                     "candela[h=" + std::to_string(i / nvs) + "][v=" + std::to_string(i % nvs) + "]",
                     "value times the candela multiplier overflows");
-    peak = std::max(peak, c);
   }
-  std::size_t n_small_negative = 0;
-  int first_negative_line = 0;
-  for (std::size_t i = 0; i < ncd; ++i) {
-    const double c = p.candela[i];
-    if (c >= 0) continue;
-    if (-c > 1e-3 * peak)
-      throw_at_line(name, static_cast<int>(p.source.candela_lines[i]),
-                    "candela[h=" + std::to_string(i / nvs) + "][v=" + std::to_string(i % nvs) + "]",
-                    "negative intensity " + std::to_string(c) + " cd exceeds 0.1 % of the peak " +
-                        std::to_string(peak) + " cd");
-    if (n_small_negative++ == 0) first_negative_line = static_cast<int>(p.source.candela_lines[i]);
-  }
-  if (n_small_negative > 0)
-    warn(first_negative_line, "candela value",
-         std::to_string(n_small_negative) + " small negative value(s) (measurement noise, < 0.1 % of peak) kept");
+  const detail::NegativeIntensities neg = detail::find_negative_intensities(p.candela, p.source.candela_lines);
+  if (neg.bad != SIZE_MAX)
+    throw_at_line(name, static_cast<int>(p.source.candela_lines[neg.bad]),
+                  "candela[h=" + std::to_string(neg.bad / nvs) + "][v=" + std::to_string(neg.bad % nvs) + "]",
+                  "negative intensity " + num(p.candela[neg.bad]) + " cd exceeds 0.1 % of the peak " +
+                      num(neg.peak) + " cd");
+  if (neg.count > 0)
+    warn(neg.first_line, "candela value",
+         std::to_string(neg.count) + " small negative value(s) (measurement noise, <= 0.1 % of peak) kept");
   if (in.remaining() > 0)
     warn(in.peek_line(), "candela value",
          std::to_string(in.remaining()) + " extra value(s) after the candela table ignored");

@@ -16,6 +16,7 @@
 #include <lumx/photometry.h>
 #include <lumx/version.h>
 
+#include "io/intensity_checks.h"
 #include "io/text_scanner.h"
 
 #include <algorithm>
@@ -44,12 +45,8 @@ enum HeaderLine : int {
   kAreaHeightC0 = 18, kDff = 22, kLorl = 23, kConversion = 24, kTilt = 25, kLampSetCount = 26,
 };
 
-std::string fmt(double v) {
-  // Short, locale-independent rendering for messages (std::to_string would print 6 decimals).
-  char buf[64];
-  const int n = std::snprintf(buf, sizeof buf, "%.10g", v);
-  return std::string(buf, n > 0 ? static_cast<std::size_t>(n) : 0);
-}
+// Short, locale-independent rendering for messages (std::to_string would print 6 decimals).
+std::string fmt(double v) { return detail::format_number(v, 10); }
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
@@ -484,28 +481,16 @@ Photometry LdtParser::parse() {
       p.source.candela_lines[mp * ngs + j] = static_cast<std::uint32_t>(ln);
     }
   }
-  // Negative intensities (same rule as the IES reader, hard-cases.md §6 #4): up to 0.1 % of the peak
-  // they are measurement noise, kept with a warning; anything larger is an error.
-  double peak = 0;
-  for (double c : p.candela) peak = std::max(peak, c);
-  std::size_t negatives = 0, bad = p.candela.size();
-  int first_negative_line = 0;
-  for (std::size_t i = 0; i < p.candela.size(); ++i) {
-    const double c = p.candela[i];
-    if (c >= 0) continue;
-    const int ln = static_cast<int>(p.source.candela_lines[i]);
-    if (-c > 1e-3 * peak && (bad == p.candela.size() || ln < static_cast<int>(p.source.candela_lines[bad])))
-      bad = i;  // report the first one in file order
-    if (negatives++ == 0 || ln < first_negative_line) first_negative_line = ln;
-  }
-  if (bad < p.candela.size())
-    fail(static_cast<int>(p.source.candela_lines[bad]),
-         "intensity (C" + fmt(p.horizontal_deg[bad / ngs]) + ", gamma " + fmt(p.vertical_deg[bad % ngs]) + ")",
-         "negative intensity " + fmt(p.candela[bad] / klm) + " cd/klm exceeds 0.1 % of the peak " + fmt(peak / klm) +
-             " cd/klm");
-  if (negatives > 0)
-    warn(first_negative_line, "intensity",
-         std::to_string(negatives) + " small negative intensity value(s) (measurement noise, <= 0.1 % of peak) kept");
+  // Negative intensities: the readers' shared policy (io/intensity_checks.h).
+  const detail::NegativeIntensities neg = detail::find_negative_intensities(p.candela, p.source.candela_lines);
+  if (neg.bad != SIZE_MAX)
+    fail(static_cast<int>(p.source.candela_lines[neg.bad]),
+         "intensity (C" + fmt(p.horizontal_deg[neg.bad / ngs]) + ", gamma " + fmt(p.vertical_deg[neg.bad % ngs]) + ")",
+         "negative intensity " + fmt(p.candela[neg.bad] / klm) + " cd/klm exceeds 0.1 % of the peak " +
+             fmt(neg.peak / klm) + " cd/klm");
+  if (neg.count > 0)
+    warn(neg.first_line, "intensity",
+         std::to_string(neg.count) + " small negative intensity value(s) (measurement noise, <= 0.1 % of peak) kept");
 
   if (extra_tokens_ > 0)
     warn(first_extra_line_, "trailing data",

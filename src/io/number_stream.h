@@ -133,11 +133,7 @@ class NumberStream {
     return true;
   }
 
-  static std::string format(double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.10g", v);
-    return buf;
-  }
+  static std::string format(double v) { return format_number(v, 10); }
 
   std::string_view text_;
   std::size_t pos_ = 0;
