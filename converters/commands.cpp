@@ -2,8 +2,10 @@
 // diagnostics on stderr and turn into exit status 1.
 #include "commands.h"
 
+#include "cli_support.h"
 #include "polar_plot.h"
 
+#include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/photometric_metrics.h>
 #include <lumx/resample.h>
@@ -20,10 +22,6 @@ namespace lumx_cli {
 namespace {
 
 using nlohmann::json;
-
-void print_diag(const lumx::Diagnostic& d) {
-  std::fprintf(stderr, "%s\n", d.str().c_str());
-}
 
 /// Reads a file, printing warnings to stderr (or collecting them into `warnings` if given).
 lumx::Photometry load(const std::string& path, std::vector<lumx::Diagnostic>* warnings = nullptr) {
@@ -44,26 +42,6 @@ json spread_json(const lumx::Spread& s) {
           {"peak_angle_deg", s.peak_angle_deg}};
 }
 
-json diag_json(const lumx::Diagnostic& d) {
-  json j = {{"severity", lumx::to_string(d.severity)}, {"field", d.field}, {"message", d.message}};
-  if (d.line > 0) j["line"] = d.line;
-  return j;
-}
-
-/// Runs a subcommand body, turning library errors into a located message on stderr and status 1.
-template <class Body>
-int guarded(const std::string& file, Body body) {
-  try {
-    return body();
-  } catch (const lumx::Error& e) {
-    print_diag(e.diagnostic());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: error: %s\n", file.c_str(), e.what());
-    return 1;
-  }
-}
-
 }  // namespace
 
 void print_version() {
@@ -76,6 +54,7 @@ void print_version() {
 }
 
 int run_info(const InfoArgs& a) {
+  if (is_bundle_path(a.file)) return run_bundle_info(a);
   return guarded(a.file, [&] {
     std::vector<lumx::Diagnostic> warnings;
     const lumx::Photometry p = load(a.file, a.json ? &warnings : nullptr);
@@ -161,8 +140,12 @@ int run_check(const CheckArgs& a) {
   for (const auto& file : a.files) {
     std::vector<lumx::Diagnostic> findings;
     try {
-      const lumx::Photometry p = load(file, &findings);
-      for (auto& d : lumx::validate(p)) findings.push_back(d);
+      if (is_bundle_path(file)) {
+        findings = lumx::check_bundle(file);
+      } else {
+        const lumx::Photometry p = load(file, &findings);
+        for (auto& d : lumx::validate(p)) findings.push_back(d);
+      }
     } catch (const lumx::Error& e) {
       findings.push_back(e.diagnostic());
     } catch (const std::exception& e) {  // e.g. out of memory: report it as a finding of this file
@@ -190,6 +173,8 @@ int run_check(const CheckArgs& a) {
 }
 
 int run_convert(const ConvertArgs& a) {
+  if (is_bundle_path(a.in)) return run_convert_from_bundle(a);
+  if (!lumx::format_from_extension(a.out)) return run_convert_to_bundle(a);
   return guarded(a.in, [&] {
     lumx::Photometry p = load(a.in);
     if (a.apply_tilt) {
@@ -223,6 +208,7 @@ int run_convert(const ConvertArgs& a) {
 }
 
 int run_plot(const PlotArgs& a) {
+  if (is_bundle_path(a.file)) return run_bundle_plot(a);
   return guarded(a.file, [&] {
     const lumx::Photometry p = load(a.file);
     lumx::PolarPlotOptions o;

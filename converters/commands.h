@@ -17,6 +17,11 @@ struct CheckArgs {
 };
 struct ConvertArgs {
   std::string in, out;
+  int map_resolution = 64;           ///< photometry → bundle: the one APL's map resolution R
+  int level = -1;                    ///< bundle → photometry: level index (-1: the first, one APL)
+  double c_step_deg = 2.5;           ///< bundle → photometry: C-plane step
+  double gamma_step_deg = 1.0;       ///< bundle → photometry: gamma step
+  double efficacy_lm_per_w = 0;      ///< bundle → photometry: lm/W for radiometric bundles
   std::string ies_version = "2019";  ///< "2002" or "2019"
   double rotate_c_deg = 0;           ///< C-plane rotation (see lumx::rotate_c_planes)
   int digits = 7;                    ///< significant digits written
@@ -26,6 +31,8 @@ struct ConvertArgs {
 };
 struct PlotArgs {
   std::string file, out, title;
+  int level = -1;  ///< bundles: level index (-1: the finest level)
+  int apl = -1;    ///< bundles: draw this APL's map (-1: draw the level's APL positions)
   int size_px = 800;
   bool force_cd = false;
 };
@@ -34,6 +41,14 @@ int run_info(const InfoArgs& a);
 int run_check(const CheckArgs& a);
 int run_convert(const ConvertArgs& a);
 int run_plot(const PlotArgs& a);
+/// True when `path` names a lumx bundle folder rather than a photometry file.
+bool is_bundle_path(const std::string& path);
+/// Bundle variants of the subcommands (bundle_commands.cpp).
+int run_bundle_info(const InfoArgs& a);
+int run_convert_to_bundle(const ConvertArgs& a);
+int run_convert_from_bundle(const ConvertArgs& a);
+int run_bundle_plot(const PlotArgs& a);
+
 /// Prints the library, ABI and file-format versions.
 void print_version();
 

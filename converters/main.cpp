@@ -36,23 +36,39 @@ const CLI::Validator finite(
     "DEG");
 
 const Command kCommands[] = {
-    {"info", "Summarise a photometry file (IES or EULUMDAT): format, grid, flux, peak, beam/field angles",
+    {"info", "Summarise a photometry file (IES or EULUMDAT: grid, flux, peak, beam/field angles) or a bundle "
+             "(levels, APLs, map resolutions, flux and bytes per level, volume grid)",
      [](CLI::App& c, int& st) {
-       c.add_option("file", g_info.file, "IES (.ies) or EULUMDAT (.ldt) file")->required();
+       c.add_option("file", g_info.file, "IES (.ies) or EULUMDAT (.ldt) file, or a bundle folder")->required();
        c.add_flag("--json", g_info.json, "print the facts as JSON");
        c.callback([&st] { st = lumx_cli::run_info(g_info); });
      }},
-    {"check", "Validate files strictly: 'FILE: OK' or located findings; exit status 1 on errors",
+    {"check", "Validate files or bundles strictly: 'FILE: OK' or located findings; exit status 1 on errors. "
+              "Bundles: manifest rules, every payload's size and SHA-256, maps finite and non-negative, "
+              "flux equal across levels within 0.1 %",
      [](CLI::App& c, int& st) {
-       c.add_option("files", g_check.files, "files to check")->required();
+       c.add_option("files", g_check.files, "files or bundle folders to check")->required();
        c.add_flag("--json", g_check.json, "print findings as JSON");
        c.add_flag("--strict", g_check.strict, "treat warnings as failures");
        c.callback([&st] { st = lumx_cli::run_check(g_check); });
      }},
-    {"convert", "Convert between IES and EULUMDAT (format from the extensions)",
+    {"convert", "Convert between IES and EULUMDAT (format from the extensions); photometry to a one-APL "
+                "bundle (output without .ies/.ldt); a bundle level's far field to IES or EULUMDAT",
      [](CLI::App& c, int& st) {
-       c.add_option("input", g_convert.in, "input file")->required();
-       c.add_option("output", g_convert.out, "output file (.ies or .ldt)")->required();
+       c.add_option("input", g_convert.in, "input file or bundle folder")->required();
+       c.add_option("output", g_convert.out, "output file (.ies or .ldt) or bundle folder")->required();
+       c.add_option("--map-resolution", g_convert.map_resolution,
+                    "photometry -> bundle: map resolution R (image 2R x R, default 64)")
+           ->check(CLI::Range(1, 4096));
+       c.add_option("--level", g_convert.level, "bundle -> photometry: level index (default 0, one APL)")
+           ->check(CLI::NonNegativeNumber);
+       c.add_option("--c-step", g_convert.c_step_deg, "bundle -> photometry: C-plane step, degrees (default 2.5)")
+           ->check(finite);
+       c.add_option("--gamma-step", g_convert.gamma_step_deg, "bundle -> photometry: gamma step, degrees (default 1)")
+           ->check(finite);
+       c.add_option("--efficacy", g_convert.efficacy_lm_per_w,
+                    "bundle -> photometry: lm/W for radiometric (W/sr) bundles")
+           ->check(finite);
        c.add_option("--ies-version", g_convert.ies_version, "LM-63 edition to write: 2019 (default) or 2002")
            ->check(CLI::IsMember({"2002", "2019"}));
        c.add_option("--rotate-c", g_convert.rotate_c_deg,
@@ -69,9 +85,12 @@ const Command kCommands[] = {
                   "readers misplace it; by default it is written as 0..360)");
        c.callback([&st] { st = lumx_cli::run_convert(g_convert); });
      }},
-    {"plot", "Draw the polar intensity diagram (C0-C180 and C90-C270) as SVG or PNG",
+    {"plot", "Draw the polar intensity diagram (C0-C180 and C90-C270) as SVG or PNG; for a bundle, one APL's "
+             "map (--apl I) or a level's APL positions in three orthographic views",
      [](CLI::App& c, int& st) {
-       c.add_option("file", g_plot.file, "IES or EULUMDAT file")->required();
+       c.add_option("file", g_plot.file, "IES or EULUMDAT file, or a bundle folder")->required();
+       c.add_option("--level", g_plot.level, "bundles: level index (default: the finest)")->check(CLI::NonNegativeNumber);
+       c.add_option("--apl", g_plot.apl, "bundles: draw this APL's directional map")->check(CLI::NonNegativeNumber);
        c.add_option("-o,--output", g_plot.out, "output .svg or .png")->required();
        c.add_option("--title", g_plot.title, "title (default: luminaire name or file name)");
        c.add_option("--size", g_plot.size_px, "image size in pixels (default 800)")->check(CLI::Range(200, 8000));
@@ -83,7 +102,7 @@ const Command kCommands[] = {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"lumx — luminaire data interchange: read, check, convert and plot IES LM-63 and EULUMDAT files", "lumx"};
+  CLI::App app{"lumx — luminaire data interchange: read, check, convert and plot IES LM-63 and EULUMDAT files and lumx bundles", "lumx"};
   app.require_subcommand(0, 1);
   bool version = false;
   app.add_flag("--version", version, "print library and file-format versions");

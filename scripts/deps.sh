@@ -3,7 +3,8 @@
 set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config
       libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev
-      libcairo2-dev fonts-dejavu-core)
+      libcairo2-dev fonts-dejavu-core libopenexr-dev libssl-dev
+      python3 python3-jsonschema)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

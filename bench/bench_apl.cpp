@@ -1,0 +1,224 @@
+// APL queries against this machine's measured ceiling (Google Benchmark).
+//
+//   build/bench/lumx_bench_apl [--benchmark_filter=...]
+//
+// The set: levels of 1, 8, 64, 256 and 512 APLs with 256 × 512 RGB maps (the dissertation's default,
+// 000 §4.6), filled with smooth random lobes; ~1.3 GB of float maps in memory. Reported per call:
+//   intensity         one bilinear map lookup (sphere_map.h) in a random direction
+//   bare_lookup       the ceiling loop of performance.md §3c, measured here in the same run: bilinear RGB
+//                     lookups at random (map, u, v) over the 512 maps, no direction mapping
+//   irradiance/N      irradiance(x, n) summed over level N at random shading points in a 2 m box, and at
+//                     coherent ones (a raster of neighbouring points, as a renderer's pixels are);
+//                     ns_per_light = time / N, to compare with bare_lookup
+//   sample/pdf        SphereMapSampler on a 256 × 512 map
+//   volume            RadianceVolume::radiance at random points and directions (32³, 4 bands, RGB)
+// Bytes per level (memory and disk) are printed by the `bundle_bytes` benchmark as counters.
+#include <lumx/apl_evaluation.h>
+#include <lumx/apl_set.h>
+#include <lumx/io/bundle_io.h>
+#include <lumx/radiance_volume.h>
+#include <lumx/sphere_map_sampler.h>
+
+#include <benchmark/benchmark.h>
+
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+using namespace lumx;
+
+namespace {
+
+constexpr int kResolution = 256;
+
+SphereMap lobe_map(std::mt19937& rng, int R = kResolution) {
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const glm::vec3 axis = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, -1.0f));
+  const float sharp = 1.0f + 30.0f * u(rng), scale = 10.0f + 100.0f * u(rng);
+  SphereMap m(R, 3);
+  for (int y = 0; y < m.height(); ++y)
+    for (int x = 0; x < m.width(); ++x) {
+      const glm::vec3 w = sphere_map::uv_to_direction({(x + 0.5f) / m.width(), (y + 0.5f) / m.height()});
+      const float v = scale * std::pow(std::max(0.0f, glm::dot(w, axis)), sharp) + 0.5f;
+      m.at(x, y, 0) = v;
+      m.at(x, y, 1) = 0.9f * v;
+      m.at(x, y, 2) = 0.8f * v;
+    }
+  // Ask for transparent huge pages, as performance.md §3c recommends for the map pool (+15–30 %).
+  ::madvise(m.data(), m.bytes(), MADV_HUGEPAGE);
+  return m;
+}
+
+const AplSet& big_set() {
+  static const AplSet set = [] {
+    AplSet s;
+    s.channels = ChannelLayout::rgb;
+    s.bounds.radius = 0.3;
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<float> u(-0.3f, 0.3f);
+    for (int n : {1, 8, 64, 256, 512}) {
+      AplLevel level;
+      level.map_resolution = kResolution;
+      for (int i = 0; i < n; ++i) {
+        Apl a;
+        a.position = {u(rng), u(rng), u(rng)};
+        a.map = lobe_map(rng);
+        a.flux = a.map.integral();
+        level.apls.push_back(std::move(a));
+      }
+      s.levels.push_back(std::move(level));
+    }
+    return s;
+  }();
+  return set;
+}
+
+std::vector<glm::vec3> random_directions(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g;
+  std::vector<glm::vec3> d(n);
+  for (auto& v : d) v = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+  return d;
+}
+
+void intensity(benchmark::State& state) {
+  std::mt19937 rng(1);
+  const SphereMap map = lobe_map(rng);
+  const auto dirs = random_directions(4096, 2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(map.lookup(dirs[i]));
+    i = (i + 1) & 4095;
+  }
+}
+BENCHMARK(intensity);
+
+void bare_lookup(benchmark::State& state) {
+  const AplLevel& level = big_set().levels[4];
+  std::uint64_t s = 0x9E3779B97F4A7C15ull;
+  auto next = [&] {  // splitmix64, as in the ceiling measurement
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  };
+  const int W = 2 * kResolution, H = kResolution;
+  for (auto _ : state) {
+    const std::uint64_t r = next();
+    const SphereMap& m = level.apls[r % level.size()].map;
+    const float px = float((r >> 16) & 0xFFFF) * (float(W - 1) / 65536.0f);
+    const float py = float((r >> 32) & 0xFFFF) * (float(H - 1) / 65536.0f);
+    const int x = int(px), y = int(py);
+    const float tx = px - float(x), ty = py - float(y);
+    const glm::vec3 v = (m.texel(x, y) * (1 - tx) + m.texel(x + 1, y) * tx) * (1 - ty) +
+                        (m.texel(x, y + 1) * (1 - tx) + m.texel(x + 1, y + 1) * tx) * ty;
+    benchmark::DoNotOptimize(v);
+  }
+}
+BENCHMARK(bare_lookup);
+
+void irradiance_at(benchmark::State& state, bool coherent) {
+  const AplSet& set = big_set();
+  const std::size_t k = std::size_t(state.range(0));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::vec3> points(4096);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    points[i] = coherent ? glm::vec3(-0.5f + float(i % 64) * 0.002f, -0.5f + float(i / 64) * 0.002f, -1.0f)
+                         : glm::vec3(u(rng), u(rng), -1.0f + 0.5f * u(rng));
+  const glm::vec3 n(0, 0, 1);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(irradiance(set, k, points[i], n).irradiance);
+    i = (i + 1) & 4095;
+  }
+  const double lights = double(set.levels[k].size());
+  state.counters["lights"] = lights;
+  state.counters["ns_per_light"] =
+      benchmark::Counter(double(state.iterations()) * lights, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+void irradiance_random(benchmark::State& state) { irradiance_at(state, false); }
+void irradiance_coherent(benchmark::State& state) { irradiance_at(state, true); }
+BENCHMARK(irradiance_random)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK(irradiance_coherent)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
+
+void sample(benchmark::State& state) {
+  std::mt19937 rng(4);
+  const SphereMap map = lobe_map(rng);
+  const SphereMapSampler sampler(map);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<glm::vec2> us(4096);
+  for (auto& v : us) v = {u(rng), u(rng)};
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(sampler.sample(us[i].x, us[i].y));
+    i = (i + 1) & 4095;
+  }
+}
+BENCHMARK(sample);
+
+void pdf(benchmark::State& state) {
+  std::mt19937 rng(5);
+  const SphereMap map = lobe_map(rng);
+  const SphereMapSampler sampler(map);
+  const auto dirs = random_directions(4096, 6);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(sampler.pdf(dirs[i]));
+    i = (i + 1) & 4095;
+  }
+}
+BENCHMARK(pdf);
+
+void volume(benchmark::State& state) {
+  RadianceVolume v(Aabb{glm::dvec3(-0.3), glm::dvec3(0.3)}, 32768, 4, 3);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  for (int i = 0; i < 20000; ++i)
+    v.add_segment({u(rng), u(rng), u(rng)}, glm::normalize(glm::dvec3(u(rng), u(rng), u(rng))), 0.3,
+                  glm::vec3(1.0f));
+  std::vector<glm::dvec3> xs(4096), ws(4096);
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    xs[i] = {u(rng), u(rng), u(rng)};
+    ws[i] = glm::normalize(glm::dvec3(u(rng), u(rng), u(rng)));
+  }
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(v.radiance(xs[i], ws[i]));
+    i = (i + 1) & 4095;
+  }
+}
+BENCHMARK(volume);
+
+void volume_add_segment(benchmark::State& state) {
+  RadianceVolume v(Aabb{glm::dvec3(-0.3), glm::dvec3(0.3)}, 32768, 4, 3);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(v.add_segment({u(rng), u(rng), u(rng)}, glm::normalize(glm::dvec3(u(rng), u(rng), u(rng))),
+                                           0.2, glm::vec3(1.0f)));
+}
+BENCHMARK(volume_add_segment);
+
+/// Bytes per level in memory (float maps) and on disk (the bundle's payloads: half, ZIP, with mips).
+void bundle_bytes(benchmark::State& state) {
+  const AplSet& set = big_set();
+  const std::string dir = (std::filesystem::temp_directory_path() / ("lumx_bench_bundle_" + std::to_string(::getpid()))).string();
+  for (auto _ : state) write_bundle(dir, set);
+  const BundleReader r(dir);
+  for (std::size_t k = 0; k < set.levels.size(); ++k) {
+    const std::string n = std::to_string(set.levels[k].size());
+    state.counters["mem_MiB_L" + n] = double(set.levels[k].map_bytes()) / (1 << 20);
+    state.counters["disk_MiB_L" + n] = double(r.manifest().levels[k].maps[0].bytes) / (1 << 20);
+  }
+  state.counters["disk_MiB_total"] = double(r.manifest().total_bytes()) / (1 << 20);
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(bundle_bytes)->Iterations(1)->Unit(benchmark::kSecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,146 @@
+// lumx/io/bundle_io.h — the lumx bundle: an APL set (and optionally a radiance volume) on disk.
+//
+// A bundle is a folder:
+//   manifest.json                  what is inside, validated by schema/bundle-manifest.schema.json
+//   levels/level_0008_r0256.exr    one OpenEXR image per (level, map resolution): the level's maps stacked
+//   levels/level_0008_r0128.exr    vertically (APL i occupies rows [i·R, (i+1)·R)), then the same maps
+//   ...                            box-filtered to R/2, R/4, ... (flux-exact, see SphereMap::downsampled)
+//   volume.exr                     the radiance volume's SH coefficients (float), if any
+// Every payload's size and SHA-256 are in the manifest; maps are half floats unless a value exceeds half's
+// range (65504) or the peak is so small that half would lose precision, in which case that payload is
+// float — never a silent Inf (hard-cases §3).
+//
+// Loading is partial by design ("a scene loads only what it needs"): BundleReader reads the manifest
+// alone; load_level() reads one level's payload at the largest stored resolution not above the caller's
+// limit, so a distant luminaire reads a few kilobytes. Every payload is size- and checksum-verified before
+// OpenEXR parses it, and every count is checked against limits before anything is allocated.
+//
+// Writing is atomic at the folder level: the bundle is assembled in a temporary sibling folder, then
+// swapped in with one rename (renameat2 RENAME_EXCHANGE when a bundle already exists), so a failed write
+// leaves the previous bundle as it was.
+#pragma once
+
+#include <lumx/apl_set.h>
+#include <lumx/diagnostic.h>
+#include <lumx/spherical_harmonics.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+LUMX_NAMESPACE_BEGIN
+
+class RadianceVolume;
+
+namespace bundle {
+inline constexpr int kFormatVersion = 1;
+inline constexpr const char* kFormatName = "lumx-bundle";
+inline constexpr const char* kManifestName = "manifest.json";
+}  // namespace bundle
+
+/// One payload file named by the manifest.
+struct BundlePayload {
+  std::string file;           ///< path relative to the bundle folder, '/'-separated
+  std::uint64_t bytes = 0;    ///< exact file size
+  std::string sha256;         ///< lowercase hex digest of the file
+  std::string pixel_type;     ///< "half" or "float"
+  int resolution = 0;         ///< map resolution R of this payload (maps only)
+};
+
+struct BundleLevelInfo {
+  int map_resolution = 0;              ///< full resolution R of this level's maps
+  std::vector<glm::vec3> position;     ///< m, one per APL
+  std::vector<glm::dvec3> flux;        ///< lm or W per channel, one per APL
+  std::vector<int> parent;             ///< index in the previous level, −1 in the first
+  std::vector<BundlePayload> maps;     ///< decreasing resolution; maps[0] is full resolution
+  ErrorTable error;
+  std::size_t apl_count() const { return position.size(); }
+};
+
+struct BundleVolumeInfo {
+  glm::dvec3 lo{0.0}, hi{0.0};  ///< grid bounds, m
+  glm::ivec3 counts{0};         ///< voxels per axis
+  double voxel_size = 0;        ///< m (cubic voxels)
+  int bands = 0;                ///< SH bands (coefficients = bands²)
+  int channels = 0;             ///< 1 or 3
+  sh::Window window = sh::Window::vallee_poussin;  ///< applied when evaluating (anti-ringing)
+  BundlePayload payload;
+};
+
+/// The manifest as read, after validation.
+struct BundleManifest {
+  int format_version = bundle::kFormatVersion;
+  std::string generator;
+  PhotometricQuantity quantity = PhotometricQuantity::photometric;
+  ChannelLayout channels = ChannelLayout::luminance;
+  BoundingSphere bounds;
+  std::map<std::string, std::string> provenance;
+  std::vector<BundleLevelInfo> levels;
+  std::optional<BundleVolumeInfo> volume;
+  std::uint64_t manifest_bytes = 0;
+
+  /// Bytes of every payload plus the manifest: what a full load reads.
+  std::uint64_t total_bytes() const;
+};
+
+enum class MapPixelType { automatic, half, float32 };
+
+struct BundleWriteOptions {
+  /// automatic: half when a payload's largest value is in [2^-4, 65504] (so values down to 2^-10 of the
+  /// peak keep half's full 11-bit precision), float otherwise. `half` refuses (throws) rather than
+  /// overflow to Inf.
+  MapPixelType pixel_type = MapPixelType::automatic;
+  /// Store box-filtered copies of each level down to this resolution (0: full resolution only).
+  int min_stored_resolution = 8;
+};
+
+/// Writes `set` (and `volume`, if given) as a bundle folder at `path`, replacing an existing bundle
+/// atomically. Refuses to replace a folder that is not a bundle (no manifest.json). Throws lumx::Error.
+void write_bundle(const std::string& path, const AplSet& set, const RadianceVolume* volume = nullptr,
+                  const BundleWriteOptions& options = {});
+
+/// Upper bounds on what a reader accepts, checked before any allocation.
+struct BundleLimits {
+  std::uint64_t max_manifest_bytes = 64ull << 20;
+  std::uint64_t max_payload_bytes = 4ull << 30;
+  std::size_t max_levels = 64;
+  std::size_t max_apls_per_level = 1u << 20;
+  /// Largest decoded size of one payload in memory (float texels or coefficients).
+  std::uint64_t max_decoded_bytes = 16ull << 30;
+};
+
+/// Opens a bundle and reads its manifest only; levels and the volume are loaded on request.
+class BundleReader {
+ public:
+  explicit BundleReader(const std::string& path, const BundleLimits& limits = {});
+
+  const BundleManifest& manifest() const { return manifest_; }
+  const std::string& path() const { return path_; }
+
+  /// The set's metadata (units, channels, bounds, provenance) with no levels.
+  AplSet empty_set() const;
+  /// One level's APLs with maps at the largest stored resolution ≤ max_resolution (0 = full).
+  AplLevel load_level(std::size_t level, int max_resolution = 0) const;
+  /// The set with the chosen levels (all if empty), each at most max_resolution.
+  AplSet load(const std::vector<std::size_t>& levels = {}, int max_resolution = 0) const;
+  bool has_volume() const { return manifest_.volume.has_value(); }
+  RadianceVolume load_volume() const;
+
+  /// Bytes read from disk through this reader so far (manifest included).
+  std::uint64_t bytes_read() const { return bytes_read_; }
+
+ private:
+  std::string read_payload(const BundlePayload& p, const std::string& field) const;
+
+  std::string path_;
+  BundleLimits limits_;
+  BundleManifest manifest_;
+  mutable std::uint64_t bytes_read_ = 0;
+};
+
+/// Findings of a full check: every payload read, checksums, the set's consistency (check_apl_set),
+/// flux equal across levels, maps non-negative and finite. Empty = OK. Never throws for bad content.
+std::vector<Diagnostic> check_bundle(const std::string& path, double flux_tolerance = 1e-3);
+
+LUMX_NAMESPACE_END

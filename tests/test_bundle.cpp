@@ -1,0 +1,376 @@
+// Bundles on disk: round trips, half/float choice, partial loading (bytes read), atomic replacement,
+// and located rejection of corrupted, truncated, inconsistent or hostile bundles.
+#include <lumx/apl_photometry.h>
+#include <lumx/apl_set.h>
+#include <lumx/io/bundle_io.h>
+#include <lumx/io/photometry_io.h>
+#include <lumx/radiance_volume.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "test_support.h"
+
+using namespace lumx;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("lumx_test_bundle_" + std::to_string(::getpid())) / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+/// A three-level set (1, 8, 64 APLs) that is a cut of one tree: each fine APL is a random lobe, each
+/// parent's map is the sum of its children's maps.
+AplSet three_level_set(int R = 32, ChannelLayout channels = ChannelLayout::rgb, float peak = 500.0f) {
+  const int nc = channel_count(channels);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  AplSet set;
+  set.channels = channels;
+  set.provenance["test"] = "three_level_set";
+  AplLevel fine;
+  fine.map_resolution = R;
+  for (int i = 0; i < 64; ++i) {
+    Apl a;
+    a.position = {u(rng) * 0.4f - 0.2f, u(rng) * 0.4f - 0.2f, u(rng) * 0.1f};
+    a.parent = i / 8;
+    a.map = SphereMap(R, nc);
+    const glm::vec3 axis = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, -1.0f));
+    const float sharp = 1.0f + 20.0f * u(rng);
+    for (int y = 0; y < a.map.height(); ++y)
+      for (int x = 0; x < a.map.width(); ++x) {
+        const glm::vec3 w = sphere_map::uv_to_direction({(x + 0.5f) / a.map.width(), (y + 0.5f) / a.map.height()});
+        const float v = peak * (std::pow(std::max(0.0f, glm::dot(w, axis)), sharp) + 2e-4f);
+        for (int c = 0; c < nc; ++c) a.map.at(x, y, c) = v * (1.0f + 0.1f * float(c));
+      }
+    fine.apls.push_back(std::move(a));
+  }
+  auto coarser = [&](const AplLevel& children, int count, int parent_group) {
+    AplLevel l;
+    l.map_resolution = R;
+    for (int p = 0; p < count; ++p) {
+      Apl a;
+      a.parent = parent_group > 0 ? p / parent_group : -1;
+      a.map = SphereMap(R, nc);
+      glm::vec3 centre(0.0f);
+      int n = 0;
+      for (const Apl& c : children.apls)
+        if (c.parent == p) {
+          for (std::size_t t = 0; t < a.map.values().size(); ++t) a.map.values()[t] += c.map.values()[t];
+          centre += c.position;
+          ++n;
+        }
+      a.position = centre / float(n);
+      l.apls.push_back(std::move(a));
+    }
+    return l;
+  };
+  AplLevel mid = coarser(fine, 8, 8);
+  AplLevel root = coarser(mid, 1, 0);
+  set.levels = {std::move(root), std::move(mid), std::move(fine)};
+  update_fluxes(set);
+  set.bounds = bounding_sphere_of(set);
+  return set;
+}
+
+std::string slurp(const fs::path& p) { return lumx_test::read_text(p); }
+void spit(const fs::path& p, const std::string& s) { std::ofstream(p, std::ios::binary | std::ios::trunc) << s; }
+
+nlohmann::json read_manifest(const fs::path& bundle) { return nlohmann::json::parse(slurp(bundle / "manifest.json")); }
+void write_manifest(const fs::path& bundle, const nlohmann::json& j) { spit(bundle / "manifest.json", j.dump(1)); }
+
+/// The located error a bad bundle produces when opened and fully loaded.
+std::string load_error(const fs::path& bundle) {
+  try {
+    BundleReader r(bundle.string());
+    r.load();
+    if (r.has_volume()) r.load_volume();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Bundle, RoundTripKeepsTheSet) {
+  const AplSet set = three_level_set();
+  const fs::path dir = scratch("roundtrip") / "lamp.lumx";
+  write_bundle(dir.string(), set);
+  BundleReader reader(dir.string());
+  const BundleManifest& m = reader.manifest();
+  ASSERT_EQ(m.levels.size(), 3u);
+  EXPECT_EQ(m.levels[2].apl_count(), 64u);
+  EXPECT_EQ(m.levels[0].maps.size(), 3u);  // 32, 16, 8
+  EXPECT_EQ(m.levels[0].maps[0].pixel_type, "half");
+  const AplSet back = reader.load();
+  EXPECT_TRUE(check_apl_set(back).empty());
+  EXPECT_EQ(back.provenance.at("test"), "three_level_set");
+  EXPECT_EQ(back.bounds.radius, set.bounds.radius);
+  for (std::size_t k = 0; k < 3; ++k)
+    for (std::size_t i = 0; i < set.levels[k].size(); ++i) {
+      const Apl &a = set.levels[k].apls[i], &b = back.levels[k].apls[i];
+      EXPECT_EQ(a.position, b.position);
+      EXPECT_EQ(a.flux, b.flux);
+      EXPECT_EQ(a.parent, b.parent);
+      // Half keeps 11 significant bits: relative rounding ≤ 2^-11 per value.
+      for (std::size_t t = 0; t < a.map.values().size(); ++t)
+        ASSERT_NEAR(a.map.values()[t], b.map.values()[t], std::ldexp(std::abs(a.map.values()[t]), -11));
+    }
+}
+
+TEST(Bundle, FloatIsUsedWhereHalfWouldOverflowOrLosePrecision) {
+  // A narrow beam: 2e5 cd peaks exceed half's 65504.
+  const AplSet bright = three_level_set(16, ChannelLayout::luminance, 2e5f);
+  const fs::path dir = scratch("bright") / "b.lumx";
+  write_bundle(dir.string(), bright);
+  BundleReader r(dir.string());
+  EXPECT_EQ(r.manifest().levels[0].maps[0].pixel_type, "float");
+  const AplSet back = r.load();
+  for (std::size_t k = 0; k < 3; ++k)
+    for (std::size_t i = 0; i < bright.levels[k].size(); ++i)
+      EXPECT_EQ(bright.levels[k].apls[i].map.values(), back.levels[k].apls[i].map.values());  // exact
+  // Forcing half refuses instead of writing Inf, and leaves nothing behind.
+  BundleWriteOptions half;
+  half.pixel_type = MapPixelType::half;
+  const fs::path dir2 = scratch("forced") / "f.lumx";
+  EXPECT_THROW(write_bundle(dir2.string(), bright, nullptr, half), Error);
+  EXPECT_FALSE(fs::exists(dir2));
+  EXPECT_TRUE(fs::is_empty(dir2.parent_path()));
+  // A dim radiometric set (peak 1e-3 W/sr) would sit in half's subnormal range: float.
+  const AplSet dim = three_level_set(16, ChannelLayout::luminance, 1e-3f);
+  const fs::path dir3 = scratch("dim") / "d.lumx";
+  write_bundle(dir3.string(), dim);
+  EXPECT_EQ(BundleReader(dir3.string()).manifest().levels[2].maps[0].pixel_type, "float");
+}
+
+TEST(Bundle, PartialLoadingReadsOnlyWhatItNeeds) {
+  const AplSet set = three_level_set(64);
+  const fs::path dir = scratch("partial") / "p.lumx";
+  write_bundle(dir.string(), set);
+  BundleReader manifest_only(dir.string());
+  const std::uint64_t total = manifest_only.manifest().total_bytes();
+  EXPECT_EQ(manifest_only.bytes_read(), manifest_only.manifest().manifest_bytes);
+  EXPECT_LT(manifest_only.bytes_read(), total / 20);
+
+  // The 8-APL level at full resolution: its own payload plus the manifest, nothing else.
+  BundleReader r8(dir.string());
+  const AplLevel level8 = r8.load_level(1);
+  EXPECT_EQ(level8.size(), 8u);
+  const std::uint64_t expected8 = r8.manifest().manifest_bytes + r8.manifest().levels[1].maps[0].bytes;
+  EXPECT_EQ(r8.bytes_read(), expected8);
+  EXPECT_LT(double(r8.bytes_read()), 0.2 * double(total));
+  std::cout << "level-8 load read " << r8.bytes_read() << " of " << total << " bytes ("
+            << 100.0 * double(r8.bytes_read()) / double(total) << " %)\n";
+
+  // The same level at a reduced resolution reads a smaller payload, and keeps the flux.
+  BundleReader r8low(dir.string());
+  const AplLevel low = r8low.load_level(1, 16);
+  EXPECT_EQ(low.map_resolution, 16);
+  EXPECT_LT(r8low.bytes_read(), r8.bytes_read() / 4);
+  for (std::size_t i = 0; i < 8; ++i) {
+    const double f = luminance_of(set.channels, set.levels[1].apls[i].flux);
+    EXPECT_NEAR(luminance_of(set.channels, low.apls[i].map.integral()), f, 1e-3 * f);
+  }
+  // A limit below the coarsest stored resolution gives the coarsest.
+  EXPECT_EQ(BundleReader(dir.string()).load_level(1, 3).map_resolution, 8);
+}
+
+TEST(Bundle, ReplacementIsAtomic) {
+  const fs::path root = scratch("atomic");
+  const fs::path dir = root / "lamp.lumx";
+  const AplSet first = three_level_set(16);
+  write_bundle(dir.string(), first);
+  const std::string manifest_before = slurp(dir / "manifest.json");
+  // A set that fails validation after nothing was written.
+  AplSet bad = first;
+  bad.levels[2].apls[5].map.at(1, 1, 0) = NAN;
+  EXPECT_THROW(write_bundle(dir.string(), bad), Error);
+  // A radiance volume with a NaN fails after every map payload was already written.
+  RadianceVolume volume(Aabb{glm::dvec3(-0.2), glm::dvec3(0.2)}, 64, 2, 1);
+  std::vector<float> coefficients = volume.coefficients();
+  coefficients[3] = NAN;
+  volume.set_coefficients(coefficients);
+  EXPECT_THROW(write_bundle(dir.string(), three_level_set(16, ChannelLayout::luminance), &volume), Error);
+  EXPECT_EQ(slurp(dir / "manifest.json"), manifest_before);
+  EXPECT_TRUE(check_bundle(dir.string()).empty());
+  // No temporary folder is left behind.
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(root)) entries += e.path() != dir;
+  EXPECT_EQ(entries, 0);
+  // A successful rewrite replaces the bundle (a different set is visible).
+  write_bundle(dir.string(), three_level_set(8, ChannelLayout::luminance));
+  EXPECT_EQ(BundleReader(dir.string()).manifest().levels[0].map_resolution, 8);
+  // A folder that is not a bundle is never replaced.
+  const fs::path other = root / "photos";
+  fs::create_directories(other);
+  spit(other / "keep.txt", "precious");
+  EXPECT_THROW(write_bundle(other.string(), first), Error);
+  EXPECT_EQ(slurp(other / "keep.txt"), "precious");
+}
+
+TEST(Bundle, CorruptedPayloadsAreRejectedWithTheirLocation) {
+  const AplSet set = three_level_set(16);
+  const fs::path root = scratch("corrupt");
+  const fs::path good = root / "good.lumx";
+  write_bundle(good.string(), set);
+  const nlohmann::json m = read_manifest(good);
+  const std::string level1 = m["levels"][1]["maps"][0]["file"];
+  auto copy = [&](const std::string& name) {
+    const fs::path p = root / name;
+    fs::copy(good, p, fs::copy_options::recursive);
+    return p;
+  };
+  {  // one flipped byte: checksum
+    const fs::path b = copy("flip.lumx");
+    std::string bytes = slurp(b / level1);
+    bytes[bytes.size() / 2] ^= 0x20;
+    spit(b / level1, bytes);
+    const std::string e = load_error(b);
+    EXPECT_NE(e.find(level1), std::string::npos) << e;
+    EXPECT_NE(e.find("/levels/1/maps/0/sha256"), std::string::npos) << e;
+  }
+  {  // truncated payload: size
+    const fs::path b = copy("trunc.lumx");
+    const std::string bytes = slurp(b / level1);
+    spit(b / level1, bytes.substr(0, bytes.size() - 100));
+    const std::string e = load_error(b);
+    EXPECT_NE(e.find("/levels/1/maps/0/bytes"), std::string::npos) << e;
+  }
+  {  // missing payload
+    const fs::path b = copy("missing.lumx");
+    fs::remove(b / level1);
+    EXPECT_NE(load_error(b).find("payload missing"), std::string::npos);
+  }
+  {  // a payload swapped for another level's, with a matching checksum: the image size disagrees
+    const fs::path b = copy("swapped.lumx");
+    nlohmann::json j = m;
+    j["levels"][1]["maps"][0] = j["levels"][2]["maps"][0];
+    j["levels"][1]["maps"][0]["file"] = level1;
+    fs::copy_file(b / std::string(m["levels"][2]["maps"][0]["file"]), b / level1, fs::copy_options::overwrite_existing);
+    write_manifest(b, j);
+    const std::string e = load_error(b);
+    EXPECT_NE(e.find("dataWindow"), std::string::npos) << e;
+  }
+  {  // check_bundle collects the findings instead of throwing
+    const fs::path b = copy("check.lumx");
+    fs::remove(b / std::string(m["levels"][2]["maps"][1]["file"]));
+    const auto findings = check_bundle(b.string());
+    ASSERT_EQ(findings.size(), 1u);
+    EXPECT_NE(findings[0].str().find("payload missing"), std::string::npos);
+  }
+}
+
+TEST(Bundle, InconsistentOrHostileManifestsAreRejected) {
+  const AplSet set = three_level_set(16, ChannelLayout::luminance);
+  const fs::path root = scratch("manifest");
+  const fs::path good = root / "good.lumx";
+  write_bundle(good.string(), set);
+  const nlohmann::json m = read_manifest(good);
+  int n = 0;
+  auto expect = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& needle) {
+    const fs::path b = root / ("case" + std::to_string(n++) + ".lumx");
+    fs::copy(good, b, fs::copy_options::recursive);
+    nlohmann::json j = m;
+    edit(j);
+    write_manifest(b, j);
+    const std::string e = load_error(b);
+    EXPECT_NE(e.find(needle), std::string::npos) << "expected \"" << needle << "\" in: " << e;
+  };
+  expect([](auto& j) { j["levels"][1]["apl_count"] = 9; }, "/levels/1/position");
+  expect([](auto& j) { j["levels"][2]["apl_count"] = 1000000; }, "/levels/2/position");  // no allocation first
+  expect([](auto& j) { j["levels"][2]["parent"][3] = 8; }, "/levels/2/parent/3");
+  expect([](auto& j) { j["levels"][1]["flux"][2][0] = 1e9; }, "/levels/1/flux/2");
+  expect([](auto& j) { j["levels"][1]["flux"][2][0] = -1; }, "/levels/1/flux/2/0");
+  expect([](auto& j) { j["levels"][0]["position"][0][1] = "x"; }, "/levels/0/position/0/1");
+  expect([](auto& j) { j["levels"][0]["maps"][0]["file"] = "../../etc/passwd"; }, "/levels/0/maps/0/file");
+  expect([](auto& j) { j["levels"][0]["maps"][0]["sha256"] = "abc"; }, "/levels/0/maps/0/sha256");
+  expect([](auto& j) { j["levels"][0]["maps"][1]["resolution"] = 3; }, "/levels/0/maps/1/resolution");
+  expect([](auto& j) { j["format_version"] = 2; }, "/format_version");
+  expect([](auto& j) { j["units"]["intensity"] = "W/sr"; }, "/units/flux");
+  expect([](auto& j) { j["channels"] = {"R", "G"}; }, "/channels");
+  expect([](auto& j) { j.erase("levels"); }, "/levels");
+  expect([](auto& j) { j["levels"][1]["map_resolution"] = 100000; }, "/levels/1/map_resolution");
+  expect([](auto& j) { j["levels"][1]["apl_count"] = 1; }, "/levels/1/apl_count");
+  // Not JSON at all (NaN is not a JSON number): the byte offset is reported.
+  const fs::path b = root / "nan.lumx";
+  fs::copy(good, b, fs::copy_options::recursive);
+  std::string text = slurp(b / "manifest.json");
+  text.replace(text.find("\"radius\": ") + 10, 1, "NaN,");
+  spit(b / "manifest.json", text);
+  const std::string e = load_error(b);
+  EXPECT_NE(e.find("manifest.json:@"), std::string::npos) << e;
+  // A payload reached through a symbolic link that leaves the bundle.
+  const fs::path s = root / "symlink.lumx";
+  fs::copy(good, s, fs::copy_options::recursive);
+  const std::string file = m["levels"][0]["maps"][0]["file"];
+  fs::copy_file(s / file, root / "outside.exr");
+  fs::remove(s / file);
+  fs::create_symlink(root / "outside.exr", s / file);
+  EXPECT_NE(load_error(s).find("outside the bundle"), std::string::npos);
+}
+
+TEST(Bundle, WriterOutputValidatesAgainstTheJsonSchema) {
+  const fs::path root = scratch("schema");
+  const fs::path dir = root / "s.lumx";
+  RadianceVolume volume(Aabb{glm::dvec3(-0.2, -0.2, 0.0), glm::dvec3(0.2, 0.2, 0.1)}, 512, 4, 3);
+  AplSet set = three_level_set(8);
+  set.levels[1].error.relative_distance = {0.5, 1, 2};
+  set.levels[1].error.relative_rmse = {0.2, 0.1, 0.05};
+  write_bundle(dir.string(), set, &volume);
+  const std::string validator = std::string(LUMX_SOURCE_DIR) + "/schema/validate.py";
+  const std::string cmd = "/usr/bin/python3 " + validator + " " + dir.string() + " > " + (root / "out.txt").string() + " 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(root / "out.txt");
+  // The schema is not vacuous: a manifest with a wrong unit and a bad checksum fails it.
+  nlohmann::json j = read_manifest(dir);
+  j["units"]["flux"] = "W";
+  j["levels"][0]["maps"][0]["sha256"] = "XYZ";
+  j["levels"][0]["surprise"] = 1;
+  write_manifest(dir, j);
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  const std::string out = slurp(root / "out.txt");
+  EXPECT_NE(out.find("/units"), std::string::npos) << out;
+  EXPECT_NE(out.find("/levels/0/maps/0/sha256"), std::string::npos) << out;
+  EXPECT_NE(out.find("surprise"), std::string::npos) << out;
+}
+
+TEST(Bundle, VolumeRoundTrips) {
+  RadianceVolume volume(Aabb{glm::dvec3(-0.3, -0.2, -0.1), glm::dvec3(0.3, 0.2, 0.4)}, 4096, 4, 3);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int i = 0; i < 2000; ++i)
+    volume.add_segment({u(rng), u(rng), u(rng) + 0.15}, glm::normalize(glm::dvec3(u(rng), u(rng), u(rng))), 0.5,
+                       glm::vec3(1.0f, 0.5f, 0.25f));
+  const fs::path dir = scratch("volume") / "v.lumx";
+  write_bundle(dir.string(), three_level_set(8), &volume);
+  BundleReader r(dir.string());
+  ASSERT_TRUE(r.has_volume());
+  const RadianceVolume back = r.load_volume();
+  EXPECT_EQ(back.counts(), volume.counts());
+  EXPECT_EQ(back.voxel_size(), volume.voxel_size());
+  EXPECT_EQ(back.coefficients(), volume.coefficients());  // float32: exact
+  EXPECT_EQ(back.radiance({0.05, 0.02, 0.1}, {0, 0, 1}), volume.radiance({0.05, 0.02, 0.1}, {0, 0, 1}));
+  EXPECT_TRUE(check_bundle(dir.string()).empty());
+}
+
+TEST(Bundle, RealPhotometryBecomesAOneLevelBundle) {
+  const Photometry p = read_photometry((fs::path(LUMX_SOURCE_DIR) / "samples" / "downlight.ies").string());
+  const AplSet set = apl_set_from_photometry(p, 64);
+  const fs::path dir = scratch("ies") / "downlight.lumx";
+  write_bundle(dir.string(), set);
+  const auto findings = check_bundle(dir.string());
+  EXPECT_TRUE(findings.empty()) << findings.front().str();
+  const AplSet back = BundleReader(dir.string()).load();
+  const double flux = set.levels[0].flux().x;
+  EXPECT_NEAR(back.levels[0].apls[0].map.integral().x, flux, 1e-3 * flux);
+}
