@@ -83,11 +83,13 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-// "1234", "12.3", "0.456": no more digits than a datasheet would print.
+// "1234", "12.3", "0.456", "1.5e+09": no more digits than a datasheet would print.
 std::string format_quantity(double v) {
   char buf[64];
   const double a = std::abs(v);
-  if (a >= 100 || a == 0)
+  if (a >= 1e7 || !std::isfinite(a))
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+  else if (a >= 100 || a == 0)
     std::snprintf(buf, sizeof buf, "%.0f", v);
   else if (a >= 10)
     std::snprintf(buf, sizeof buf, "%.1f", v);
@@ -127,10 +129,14 @@ std::string format_decade(int k) {
   return buf;
 }
 
-// A tick value with `decimals` digits after the point; never "-0".
+// A tick value with `decimals` digits after the point; never "-0". Very small steps and very large
+// values fall back to three significant digits.
 std::string format_tick(double v, int decimals) {
   char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  if (decimals > 6 || std::abs(v) >= 1e7)
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
   std::string s = buf;
   if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
   return s;
@@ -144,7 +150,9 @@ double nice_step(double raw) {
 }
 
 // Digits after the point that a tick step needs.
-int step_decimals(double step) { return std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9))); }
+int step_decimals(double step) {
+  return std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9)));
+}
 
 class Painter {
  public:
@@ -153,8 +161,7 @@ class Painter {
   void check(const char* step) const {
     const cairo_status_t st = cairo_status(cr_);
     if (st != CAIRO_STATUS_SUCCESS)
-      fail(file_, "output",
-           std::string("cairo failed while drawing the ") + step + ": " + cairo_status_to_string(st));
+      fail(file_, "output", std::string("cairo failed while drawing the ") + step + ": " + cairo_status_to_string(st));
   }
 
   void color(const Rgb& c, double alpha = 1.0) const { cairo_set_source_rgba(cr_, c.r, c.g, c.b, alpha); }
@@ -210,9 +217,9 @@ class Painter {
 template <class Draw>
 void render_and_write(const std::string& out_path, bool svg, double width, double height, Draw&& draw) {
   std::string bytes;
-  SurfacePtr surface(svg ? cairo_svg_surface_create_for_stream(append_bytes, &bytes, width, height)
-                         : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(width),
-                                                      static_cast<int>(height)));
+  SurfacePtr surface(
+      svg ? cairo_svg_surface_create_for_stream(append_bytes, &bytes, width, height)
+          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(width), static_cast<int>(height)));
   auto check_surface = [&](const char* step) {
     const cairo_status_t st = cairo_surface_status(surface.get());
     if (st != CAIRO_STATUS_SUCCESS)
@@ -469,8 +476,9 @@ class MapRenderer {
     const int f = svg ? s_ : 1;
     SurfacePtr img = make_texels(f);
     if (cairo_surface_status(img.get()) != CAIRO_STATUS_SUCCESS)
-      fail("", "output", std::string("cairo failed to create the texel image: ") +
-                             cairo_status_to_string(cairo_surface_status(img.get())));
+      fail("", "output",
+           std::string("cairo failed to create the texel image: ") +
+               cairo_status_to_string(cairo_surface_status(img.get())));
     for (int half = 0; half < 2; ++half) {
       const double x0 = img_x_ + half * (side_ + gap_);
       cairo_save(cr);
@@ -545,10 +553,9 @@ class MapRenderer {
       pt.font(label_pt_, true);
       pt.text_middle(unit, x1 + 1.5 * label_pt_, bar_y_ + 0.5 * bar_h_, 0);
     }
-    const std::string note = tm_.all_zero
-                                 ? "all zero: the bar shows 0..1"
-                                 : "each square is equal-area: pole at the centre, horizon at the edge; "
-                                   "C0 to the right, C90 downwards";
+    const std::string note = tm_.all_zero ? "all zero: the bar shows 0..1"
+                                          : "each square is equal-area: pole at the centre, horizon at the edge; "
+                                            "C0 to the right, C90 downwards";
     pt.color(kMuted);
     pt.fit_font(note, 0.85 * label_pt_, false, cw_);
     pt.text_baseline(note, 0.5 * W_, note_base_, 0.5);
@@ -572,6 +579,12 @@ class MapRenderer {
 // APL positions
 
 constexpr double kMinExtentM = 1e-3;  // the smallest extent shown, so coincident APLs stay drawable
+constexpr double kMaxCoordM = 1e6;    // positions farther out are treated as garbage and not drawn
+
+bool drawable(const glm::dvec3& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::abs(p.x) <= kMaxCoordM &&
+         std::abs(p.y) <= kMaxCoordM && std::abs(p.z) <= kMaxCoordM;
+}
 
 struct View {
   const char* name;
@@ -591,12 +604,11 @@ constexpr View kViews[3] = {
 
 class AplRenderer {
  public:
-  AplRenderer(const AplLevel& level, ChannelLayout channels, const BoundingSphere& bounds,
-              const AplPlotOptions& o)
+  AplRenderer(const AplLevel& level, ChannelLayout channels, const BoundingSphere& bounds, const AplPlotOptions& o)
       : o_(o), bounds_(bounds) {
     for (const Apl& a : level.apls) {
       const glm::dvec3 p(a.position);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      if (!drawable(p)) {
         ++skipped_;
         continue;
       }
@@ -608,8 +620,8 @@ class AplRenderer {
       total_ += f;
     }
     count_ = level.apls.size();
-    show_bounds_ = std::isfinite(bounds.radius) && bounds.radius > 0 && std::isfinite(bounds.center.x) &&
-                   std::isfinite(bounds.center.y) && std::isfinite(bounds.center.z);
+    show_bounds_ =
+        std::isfinite(bounds.radius) && bounds.radius > 0 && bounds.radius <= kMaxCoordM && drawable(bounds.center);
 
     glm::dvec3 lo(INFINITY), hi(-INFINITY);
     for (const glm::dvec3& p : pos_) {
@@ -716,7 +728,7 @@ class AplRenderer {
                       format_quantity(total_) + " " + o_.flux_unit;
     if (show_bounds_) cap += "   ·   bounding sphere r = " + format_metres(bounds_.radius);
     cap += "   ·   grid " + format_metres(step_);
-    if (skipped_ > 0) cap += "   ·   " + std::to_string(skipped_) + " with non-finite positions not drawn";
+    if (skipped_ > 0) cap += "   ·   " + std::to_string(skipped_) + " with non-finite or absurd positions not drawn";
     pt.color(kMuted);
     pt.fit_font(cap, 0.95 * label_pt_, false, W_ - 2 * m_, 0.35);
     pt.text_baseline(cap, 0.5 * W_, caption_base_, 0.5);
@@ -951,8 +963,7 @@ void write_sphere_map_image(const SphereMap& map, const std::string& out_path, c
              std::to_string(static_cast<long long>(scale) * tw) + " px wide (at most " +
              std::to_string(kMaxImageWidth) + ")");
   const MapRenderer renderer(map, o, scale);
-  render_and_write(out_path, svg, renderer.width(), renderer.height(),
-                   [&](Painter& pt) { renderer.draw(pt, svg); });
+  render_and_write(out_path, svg, renderer.width(), renderer.height(), [&](Painter& pt) { renderer.draw(pt, svg); });
 }
 
 void write_apl_positions_plot(const AplLevel& level, ChannelLayout channels, const BoundingSphere& bounds,

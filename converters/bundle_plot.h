@@ -41,8 +41,9 @@ struct AplPlotOptions {
 /// proportional to its flux (flux.x for one channel, Rec. 709 luminance for RGB; the largest flux gets
 /// the maximum radius, none is smaller than 1.5 px), nearer APLs drawn over farther ones. Axes carry
 /// metre ticks; a legend gives the flux of the largest disc. SVG or PNG by extension, written atomically.
-/// APLs with non-finite positions are skipped (and counted in the caption). Throws lumx::Error: field
-/// "output" for an unknown extension or a cairo failure, "size" for a width outside 300..8000.
+/// APLs with non-finite positions (or beyond 1e6 m) are skipped and counted in the caption. Throws
+/// lumx::Error: field "output" for an unknown extension or a cairo failure, "size" for a width outside
+/// 300..8000; write errors as lumx::write_file_atomically reports them.
 void write_apl_positions_plot(const AplLevel& level, ChannelLayout channels, const BoundingSphere& bounds,
                               const std::string& out_path, const AplPlotOptions& o);
 

@@ -167,3 +167,64 @@ TEST(Cli, NonFiniteAnglesAreUsageErrors) {
   EXPECT_NE(run("convert " + q(kSample) + " " + q(d / "o.ies") + " --apply-tilt inf", false).status, 0);
   EXPECT_FALSE(fs::exists(d / "o.ies"));
 }
+
+// ---- bundles ----
+
+TEST(CliBundle, PhotometryToBundleAndBackKeepsTheFlux) {
+  const fs::path d = scratch("bundle_roundtrip");
+  const fs::path bundle = d / "downlight.lumx";
+  const CliRun c = run("convert " + q(kSample) + " " + q(bundle) + " --map-resolution 128");
+  ASSERT_EQ(c.status, 0) << c.out;
+  EXPECT_TRUE(fs::exists(bundle / "manifest.json"));
+  const CliRun info = run("info --json " + q(bundle), false);
+  ASSERT_EQ(info.status, 0) << info.out;
+  const auto j = nlohmann::json::parse(info.out);
+  ASSERT_EQ(j["levels"].size(), 1u);
+  EXPECT_EQ(j["levels"][0]["apls"], 1);
+  EXPECT_EQ(j["levels"][0]["map_resolution"], 128);
+  const double bundle_flux = j["levels"][0]["flux_lm"];
+  EXPECT_EQ(run("check " + q(bundle)).out, bundle.string() + ": OK\n");
+  // Back to IES: the far field of the one APL carries the file's flux (within 0.5 %).
+  const fs::path ies = d / "back.ies";
+  ASSERT_EQ(run("convert " + q(bundle) + " " + q(ies)).status, 0);
+  const auto a = nlohmann::json::parse(run("info --json " + q(kSample), false).out);
+  const auto b = nlohmann::json::parse(run("info --json " + q(ies), false).out);
+  const double fa = a["flux_lm"], fb = b["flux_lm"];
+  EXPECT_NEAR(fb, fa, 0.005 * fa);
+  EXPECT_NEAR(bundle_flux, fa, 1e-4 * fa);
+  EXPECT_NEAR(double(b["max_cd"]), double(a["max_cd"]), 0.03 * double(a["max_cd"]));
+}
+
+TEST(CliBundle, CheckReportsALocatedFindingAndFails) {
+  const fs::path d = scratch("bundle_check");
+  const fs::path bundle = d / "b.lumx";
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(bundle)).status, 0);
+  const auto m = nlohmann::json::parse(lumx_test::read_text(bundle / "manifest.json"));
+  const fs::path payload = bundle / std::string(m["levels"][0]["maps"][1]["file"]);
+  std::string bytes = lumx_test::read_text(payload);
+  bytes[bytes.size() - 7] ^= 1;
+  std::ofstream(payload, std::ios::binary | std::ios::trunc) << bytes;
+  const CliRun c = run("check " + q(bundle));
+  EXPECT_EQ(c.status, 1);
+  EXPECT_NE(c.out.find(payload.string()), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("/levels/0/maps/1/sha256"), std::string::npos) << c.out;
+  const CliRun info = run("info " + q(d / "nothing.lumx"));
+  EXPECT_EQ(info.status, 1);
+}
+
+TEST(CliBundle, PlotsMapsAndPositions) {
+  const fs::path d = scratch("bundle_plot");
+  const fs::path bundle = d / "b.lumx";
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(bundle)).status, 0);
+  for (const char* name : {"map.png", "map.svg"}) {
+    const CliRun p = run("plot " + q(bundle) + " --apl 0 -o " + q(d / name));
+    EXPECT_EQ(p.status, 0) << p.out;
+    EXPECT_GT(fs::file_size(d / name), 1000u) << name;
+  }
+  const CliRun p = run("plot " + q(bundle) + " --level 0 -o " + q(d / "apls.svg"));
+  EXPECT_EQ(p.status, 0) << p.out;
+  EXPECT_NE(lumx_test::read_text(d / "apls.svg").find("<svg"), std::string::npos);
+  EXPECT_EQ(run("plot " + q(bundle) + " --apl 5 -o " + q(d / "x.png")).status, 1);
+  EXPECT_EQ(run("plot " + q(bundle) + " --level 3 -o " + q(d / "x.png")).status, 1);
+  EXPECT_FALSE(fs::exists(d / "x.png"));
+}

@@ -2,8 +2,8 @@
 // angle per texel, bilinear lookups across the equator seam, the squares' corners and the poles, and the
 // map's integral under splatting and downsampling. All random inputs come from fixed seeds.
 //
-// Tests named DISABLED_* document defects of sphere_map.h found here (they fail against it as written);
-// each names the fix that makes it pass. Run them with --gtest_also_run_disabled_tests.
+// The last group of tests guards defects this suite found in a first version (corner seams, exact
+// constants, the shared u = 0.5 edge, precision at the poles); each names the fix.
 #include <lumx/sphere_map.h>
 
 #include <gtest/gtest.h>
@@ -48,8 +48,10 @@ glm::dvec3 square_point_direction(int half, double sx, double sy) {
 }
 
 /// A lower-hemisphere direction whose u is 0.5, the upper square's right edge (see
-/// DISABLED_LowerSquaresLeftEdgeRoundTrips).
-bool maps_onto_the_shared_edge(const glm::vec3& w) { return w.z < 0.0f && sphere_map::direction_to_uv(w).x == 0.5f; }
+/// LowerSquaresLeftEdgeRoundTrips).
+bool maps_onto_the_shared_edge(const glm::vec3& w) {
+  return w.z < 0.0f && sphere_map::direction_to_uv(w).x == 0.5f;
+}
 
 /// Direction of the centre of texel (x, y) of a map of square resolution R.
 glm::vec3 texel_centre_direction(int R, int x, int y) {
@@ -66,7 +68,9 @@ SphereMap map_of(int R, const std::function<double(const glm::vec3&)>& f) {
 }
 
 /// The smooth test function 1 + 0.5x + 0.3y + 0.2z (|∇f| ≤ 0.62 per radian, range [0.38, 1.62]).
-double smooth(const glm::vec3& w) { return 1.0 + 0.5 * w.x + 0.3 * w.y + 0.2 * w.z; }
+double smooth(const glm::vec3& w) {
+  return 1.0 + 0.5 * w.x + 0.3 * w.y + 0.2 * w.z;
+}
 
 SphereMap random_map(int R, int channels, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -82,7 +86,9 @@ glm::vec3 near_equator(double phi, double eps) {
 }
 
 /// Azimuth of a square corner on the equator: π/4 + k·π/2.
-double corner_azimuth(int k) { return kPi / 4 + k * kPi / 2; }
+double corner_azimuth(int k) {
+  return kPi / 4 + k * kPi / 2;
+}
 
 /// Distance in azimuth from φ to the nearest square corner on the equator.
 double distance_to_corner(double phi) {
@@ -136,8 +142,10 @@ double texel_solid_angle_polygon(int R, int x, int y, int m) {
   std::vector<glm::dvec3> ring;
   for (int k = 0; k < m; ++k) ring.push_back(square_point_direction(half, (lx + double(k) / m) / R, double(y) / R));
   for (int k = 0; k < m; ++k) ring.push_back(square_point_direction(half, (lx + 1.0) / R, (y + double(k) / m) / R));
-  for (int k = 0; k < m; ++k) ring.push_back(square_point_direction(half, (lx + 1.0 - double(k) / m) / R, (y + 1.0) / R));
-  for (int k = 0; k < m; ++k) ring.push_back(square_point_direction(half, double(lx) / R, (y + 1.0 - double(k) / m) / R));
+  for (int k = 0; k < m; ++k)
+    ring.push_back(square_point_direction(half, (lx + 1.0 - double(k) / m) / R, (y + 1.0) / R));
+  for (int k = 0; k < m; ++k)
+    ring.push_back(square_point_direction(half, double(lx) / R, (y + 1.0 - double(k) / m) / R));
   double sum = 0;
   for (std::size_t i = 0; i < ring.size(); ++i)
     sum += triangle_solid_angle(centre, glm::normalize(ring[i]), glm::normalize(ring[(i + 1) % ring.size()]));
@@ -177,16 +185,16 @@ TEST(SphereMapTransform, DirectionRoundTripOverRandomDirections) {
     worst_angle = std::max(worst_angle, angle);
     if (std::abs(w.z) <= 0.99f) worst_angle_off_pole = std::max(worst_angle_off_pole, angle);
   }
-  std::printf("  round trip: worst dot 1 - %.3g, worst angle %.3g rad (%.3g rad for |z| <= 0.99)\n",
-              1.0 - worst_dot, worst_angle, worst_angle_off_pole);
+  std::printf("  round trip: worst dot 1 - %.3g, worst angle %.3g rad (%.3g rad for |z| <= 0.99)\n", 1.0 - worst_dot,
+              worst_angle, worst_angle_off_pole);
   EXPECT_GT(worst_dot, 1.0 - 1e-6);
   EXPECT_LT(worst_angle_off_pole, 2e-6);
 }
 
 TEST(SphereMapTransform, DirectionRoundTripAtPolesEquatorCornersAndAxisPlanes) {
-  std::vector<glm::vec3> dirs = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0},
-                                 {0.0f, -0.0f, 1.0f}, {-0.0f, 0.0f, -1.0f}, {1, -0.0f, 0}, {-1, -0.0f, 0},
-                                 {-1, 0.0f, -0.0f}, {0, 1, -0.0f}};
+  std::vector<glm::vec3> dirs = {{0, 0, 1},     {0, 0, -1},     {1, 0, 0},           {-1, 0, 0},
+                                 {0, 1, 0},     {0, -1, 0},     {0.0f, -0.0f, 1.0f}, {-0.0f, 0.0f, -1.0f},
+                                 {1, -0.0f, 0}, {-1, -0.0f, 0}, {-1, 0.0f, -0.0f},   {0, 1, -0.0f}};
   // The directions of both squares' corners and edge midpoints (all on the equator).
   for (float u : {0.0f, 0.25f, 0.5f, std::nextafter(0.5f, 1.0f), 0.75f, 1.0f})
     for (float v : {0.0f, 0.5f, 1.0f}) dirs.push_back(sphere_map::uv_to_direction({u, v}));
@@ -208,7 +216,7 @@ TEST(SphereMapTransform, DirectionRoundTripAtPolesEquatorCornersAndAxisPlanes) {
     }
   double worst_dot = 1.0;
   for (const glm::vec3& w : dirs) {
-    if (maps_onto_the_shared_edge(w)) continue;  // DISABLED_LowerSquaresLeftEdgeRoundTrips
+    if (maps_onto_the_shared_edge(w)) continue;  // LowerSquaresLeftEdgeRoundTrips
     const glm::vec3 back = sphere_map::uv_to_direction(sphere_map::direction_to_uv(w));
     const double d = glm::dot(glm::dvec3(w), glm::dvec3(back));
     worst_dot = std::min(worst_dot, d);
@@ -219,7 +227,7 @@ TEST(SphereMapTransform, DirectionRoundTripAtPolesEquatorCornersAndAxisPlanes) {
 
 TEST(SphereMapTransform, UvRoundTripInsideBothSquares) {
   // Square coordinates survive uv → direction → uv to 3e-5 (the worst case is next to the poles, see
-  // DISABLED_PoleRoundTripsKeepFullPrecision; elsewhere it is ~1e-6). The lower square's border is the
+  // PoleRoundTripsKeepFullPrecision; elsewhere it is ~1e-6). The lower square's border is the
   // equator, which belongs to the upper square, so it is checked separately below.
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -236,7 +244,8 @@ TEST(SphereMapTransform, UvRoundTripInsideBothSquares) {
   // The upper square's border, including its corners and u = 0.5, maps back onto itself.
   for (int i = 0; i <= 256; ++i) {
     const float t = float(i) / 256;
-    for (glm::vec2 uv : {glm::vec2(0.0f, t), glm::vec2(0.5f, t), glm::vec2(0.5f * t, 0.0f), glm::vec2(0.5f * t, 1.0f)}) {
+    for (glm::vec2 uv :
+         {glm::vec2(0.0f, t), glm::vec2(0.5f, t), glm::vec2(0.5f * t, 0.0f), glm::vec2(0.5f * t, 1.0f)}) {
       const glm::vec2 back = sphere_map::direction_to_uv(sphere_map::uv_to_direction(uv));
       EXPECT_NEAR(back.x, uv.x, 2e-6);
       EXPECT_NEAR(back.y, uv.y, 2e-6);
@@ -319,7 +328,7 @@ TEST(SphereMapGeometry, UniformDirectionsFillTexelsEvenly) {
 // ---- lookups -----------------------------------------------------------------------------------------
 
 TEST(SphereMapLookup, ConstantMapLooksUpWithinOneUlpOfTheConstant) {
-  // Exactly constant for constants like 1 and 0.3; see DISABLED_ConstantMapLooksUpExactlyConstant.
+  // Exactly constant for constants like 1 and 0.3; see ConstantMapLooksUpExactlyConstant.
   std::mt19937_64 rng(3);
   for (float c : {1.0f, 0.1f, 3.7f, 1e-3f, 12345.678f}) {
     for (int channels : {1, 3}) {
@@ -362,7 +371,7 @@ TEST(SphereMapLookup, SmoothMapReproducesTheFunctionToOrderTexelSize) {
 TEST(SphereMapLookup, SmoothMapIsContinuousAcrossTheEquatorAwayFromCorners) {
   // A continuous interpolant jumps by O(eps) between directions eps above and below the equator; its
   // slope is about |∇f| ≤ 0.62 /rad times the map's distortion, so 20·eps is a loose bound.
-  // (Within one texel of the squares' corners, see DISABLED_SmoothMapIsContinuousAtSquareCorners.)
+  // (Within one texel of the squares' corners, see SmoothMapIsContinuousAtSquareCorners.)
   const double eps = 1e-5;
   for (int R : {4, 16, 64}) {
     const SphereMap m = map_of(R, smooth);
@@ -480,14 +489,14 @@ TEST(SphereMap, LayoutSizesAndSolidAngle) {
   EXPECT_EQ(c, 2);
 }
 
-// ---- known defects of sphere_map.h (fail as written; enable once fixed) --------------------------------
+// ---- regressions: defects found in the first version of sphere_map.h ----------------------------------
 
 // fetch() flips to the other square once even when both coordinates are outside (past a corner). Along
 // the equator within half a texel of a corner the two squares then weight the two corner texels U, L
 // differently: the upper square returns (1 − t)(U + L)/2 + t·L, the lower (1 − t)(U + L)/2 + t·U, a jump
 // of t·|U − L| up to |U − L|/2. Fix: flip once per crossed edge (`half ^= crossed_x ^ crossed_y`), so the
 // texel diagonally past a corner is the square's own corner texel.
-TEST(SphereMapLookup, DISABLED_SmoothMapIsContinuousAtSquareCorners) {
+TEST(SphereMapLookup, SmoothMapIsContinuousAtSquareCorners) {
   const double eps = 1e-5;
   for (int R : {4, 16, 64}) {
     const SphereMap m = map_of(R, smooth);
@@ -497,7 +506,7 @@ TEST(SphereMapLookup, DISABLED_SmoothMapIsContinuousAtSquareCorners) {
   }
 }
 
-TEST(SphereMapLookup, DISABLED_RandomMapIsContinuousAtSquareCorners) {
+TEST(SphereMapLookup, RandomMapIsContinuousAtSquareCorners) {
   const double eps = 1e-5;
   for (int R : {1, 4, 16, 64}) {
     const SphereMap m = random_map(R, 1, 100 + R);
@@ -509,7 +518,7 @@ TEST(SphereMapLookup, DISABLED_RandomMapIsContinuousAtSquareCorners) {
 
 // (v0·(1 − t) + v1·t) is not exactly v0 when v1 == v0 (0.1f: half of all lookups are 1 ulp off).
 // Fix: interpolate as v0 + t·(v1 − v0), which is exact when v1 == v0.
-TEST(SphereMapLookup, DISABLED_ConstantMapLooksUpExactlyConstant) {
+TEST(SphereMapLookup, ConstantMapLooksUpExactlyConstant) {
   std::mt19937_64 rng(3);
   for (float c : {1.0f, 0.1f, 3.7f, 1e-3f, 12345.678f}) {
     SphereMap m(8, 1);
@@ -525,13 +534,14 @@ TEST(SphereMapLookup, DISABLED_ConstantMapLooksUpExactlyConstant) {
 // rad (hard-cases §44 asks < 1e-5), square coordinates within ~1e-4 of the centre collapse onto it, and
 // at R ≥ 2048 texel_of puts such directions in the wrong central texel. Fix: for unit w,
 // ρ = √((x² + y²) / (1 + |z|)), the same quantity without the cancellation.
-TEST(SphereMapTransform, DISABLED_PoleRoundTripsKeepFullPrecision) {
+TEST(SphereMapTransform, PoleRoundTripsKeepFullPrecision) {
   double worst_angle = 0;
   for (double theta = 1e-6; theta < 1e-2; theta *= 1.1)
     for (int k = 0; k < 16; ++k)
       for (double s : {1.0, -1.0}) {
         const glm::vec3 w = direction_from(s * std::cos(theta), 0.4 * k);
-        worst_angle = std::max(worst_angle, angle_between(w, sphere_map::uv_to_direction(sphere_map::direction_to_uv(w))));
+        worst_angle =
+            std::max(worst_angle, angle_between(w, sphere_map::uv_to_direction(sphere_map::direction_to_uv(w))));
       }
   std::printf("  worst round-trip angle near the poles %.3g rad\n", worst_angle);
   EXPECT_LT(worst_angle, 1e-5);
@@ -551,7 +561,7 @@ TEST(SphereMapTransform, DISABLED_PoleRoundTripsKeepFullPrecision) {
 // uv_to_direction reads as the upper square's right edge: the round trip returns the mirror direction
 // (x → −x, up to 180° off). Fix: in direction_to_uv, when half == 1 and u == 0.5f return (0, s.y), the
 // same equator point seen from the upper square.
-TEST(SphereMapTransform, DISABLED_LowerSquaresLeftEdgeRoundTrips) {
+TEST(SphereMapTransform, LowerSquaresLeftEdgeRoundTrips) {
   std::vector<glm::vec3> dirs = {sphere_map::uv_to_direction({std::nextafter(0.5f, 1.0f), 0.5f}),
                                  sphere_map::uv_to_direction({std::nextafter(0.5f, 1.0f), 0.1f})};
   for (double z : {-1e-8, -5e-8, -1e-7})
@@ -559,6 +569,7 @@ TEST(SphereMapTransform, DISABLED_LowerSquaresLeftEdgeRoundTrips) {
   for (const glm::vec3& w : dirs) {
     const glm::vec3 back = sphere_map::uv_to_direction(sphere_map::direction_to_uv(w));
     EXPECT_GT(glm::dot(glm::dvec3(w), glm::dvec3(back)), 1.0 - 1e-6)
-        << "w = (" << w.x << ", " << w.y << ", " << w.z << ") came back as (" << back.x << ", " << back.y << ", " << back.z << ")";
+        << "w = (" << w.x << ", " << w.y << ", " << w.z << ") came back as (" << back.x << ", " << back.y << ", "
+        << back.z << ")";
   }
 }

@@ -88,7 +88,7 @@ inline void build_cdf(const double* w, std::size_t n, double total, std::uint32_
 /// interval, in [0, 1). Requires cdf[n] = kQuanta.
 inline std::size_t find_cell(const std::uint32_t* cdf, std::size_t n, float u, double& offset) {
   const double t = double(clamp_unit(u)) * double(kQuanta);  // in [0, kQuanta)
-  const std::uint32_t k = std::uint32_t(t);                   // ⌊t⌋ ≤ kQuanta − 1
+  const std::uint32_t k = std::uint32_t(t);                  // ⌊t⌋ ≤ kQuanta − 1
   // Last i with cdf[i] ≤ k; cdf[0] = 0 ≤ k < kQuanta = cdf[n], so i ∈ [0, n) and cdf[i+1] > k ≥ cdf[i].
   const std::size_t i = std::size_t(std::upper_bound(cdf, cdf + n + 1, k) - cdf) - 1;
   offset = (t - double(cdf[i])) / double(cdf[i + 1] - cdf[i]);
@@ -139,8 +139,7 @@ class PiecewiseConstant1D {
     check_size(weights.size());
     for (std::size_t i = 0; i < weights.size(); ++i)
       if (!(std::isfinite(weights[i]) && weights[i] >= 0.0))
-        throw std::invalid_argument("PiecewiseConstant1D: weight " + std::to_string(i) +
-                                    " is negative or not finite");
+        throw std::invalid_argument("PiecewiseConstant1D: weight " + std::to_string(i) + " is negative or not finite");
     build(weights);
   }
 
@@ -210,8 +209,8 @@ class PiecewiseConstant2D {
   PiecewiseConstant2D(const float* weights, int nx, int ny) : nx_(nx), ny_(ny) {
     if (nx < 1 || ny < 1 || std::size_t(nx) > piecewise_constant::kMaxCells ||
         std::size_t(ny) > piecewise_constant::kMaxCells)
-      throw std::invalid_argument("PiecewiseConstant2D: size " + std::to_string(nx) + " x " +
-                                  std::to_string(ny) + " outside [1, 2^24]");
+      throw std::invalid_argument("PiecewiseConstant2D: size " + std::to_string(nx) + " x " + std::to_string(ny) +
+                                  " outside [1, 2^24]");
     const std::size_t w = std::size_t(nx), h = std::size_t(ny);
     conditional_cdf_.assign(h * (w + 1), 0);
     std::vector<double> row(w), row_sums(h);
@@ -256,6 +255,7 @@ class PiecewiseConstant2D {
   }
 
   /// Density at (x, y) ∈ [0, 1]²; 0 outside, for NaN, and for a zero function.
+  float pdf(float x, float y) const { return pdf(glm::vec2(x, y)); }
   float pdf(const glm::vec2& p) const {
     if (is_zero() || !(p.x >= 0.0f && p.x <= 1.0f && p.y >= 0.0f && p.y <= 1.0f)) return 0.0f;
     return cell_pdf(piecewise_constant::cell_of(p.x, std::size_t(nx_)),
@@ -266,8 +266,7 @@ class PiecewiseConstant2D {
   double probability(int x, int y) const {
     if (is_zero()) return 0.0;
     const std::uint32_t* cdf = row_cdf(std::size_t(y));
-    return marginal_.probability(std::size_t(y)) * double(cdf[x + 1] - cdf[x]) /
-           double(piecewise_constant::kQuanta);
+    return marginal_.probability(std::size_t(y)) * double(cdf[x + 1] - cdf[x]) / double(piecewise_constant::kQuanta);
   }
 
   /// Bytes of table data held in memory.
@@ -276,9 +275,8 @@ class PiecewiseConstant2D {
  private:
   static const float* checked_data(const std::vector<float>& weights, int nx, int ny) {
     if (nx < 1 || ny < 1 || weights.size() != std::size_t(nx) * std::size_t(ny))
-      throw std::invalid_argument("PiecewiseConstant2D: " + std::to_string(weights.size()) +
-                                  " weights for " + std::to_string(nx) + " x " + std::to_string(ny) +
-                                  " cells");
+      throw std::invalid_argument("PiecewiseConstant2D: " + std::to_string(weights.size()) + " weights for " +
+                                  std::to_string(nx) + " x " + std::to_string(ny) + " cells");
     return weights.data();
   }
 

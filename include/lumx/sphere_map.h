@@ -10,9 +10,9 @@
 //
 // Seams. The square's border is the equator, and the same square coordinate on the other hemisphere is
 // the same equator point, so the texel just outside one square's edge is the mirror-image texel just
-// inside the other square. Bilinear lookups use that rule (one flip for edges and corners alike), which
-// makes the interpolant continuous across the equator; the poles are the squares' centres, interior
-// points where nothing special is needed.
+// inside the other square. Bilinear lookups use that rule (one flip per edge crossed, so the texel past a
+// corner is the square's own corner texel), which makes the interpolant continuous across the equator;
+// the poles are the squares' centres, interior points where nothing special is needed.
 //
 // Directions are in the luminaire's photometric frame (photometric_frame.h: +Z up, nadir −Z).
 #pragma once
@@ -77,7 +77,9 @@ inline glm::vec2 disk_to_square(float rho, float phi) {
 /// cannot tell the two squares' shared edge apart.
 inline glm::vec2 direction_to_square(const glm::vec3& w, int& half) {
   half = w.z < 0.0f ? 1 : 0;
-  const float rho = std::sqrt(std::max(0.0f, 1.0f - std::abs(w.z)));  // Lambert: ρ² = 1 − |z|
+  // Lambert: ρ² = 1 − |z| = (x² + y²) / (1 + |z|) for unit w; the second form keeps ρ's precision near
+  // the poles, where 1 − |z| in float is quantised to multiples of 2⁻²⁴.
+  const float rho = std::sqrt((w.x * w.x + w.y * w.y) / (1.0f + std::abs(w.z)));
   const float phi = (w.x == 0.0f && w.y == 0.0f) ? 0.0f : std::atan2(w.y, w.x);
   return disk_to_square(rho, phi);
 }
@@ -87,7 +89,11 @@ inline glm::vec2 direction_to_square(const glm::vec3& w, int& half) {
 inline glm::vec2 direction_to_uv(const glm::vec3& w) {
   int half;
   const glm::vec2 s = direction_to_square(w, half);
-  return {0.5f * (s.x + float(half)), s.y};
+  const float u = 0.5f * (s.x + float(half));
+  // u = 0.5 is the upper square's right edge. A lower-square point that rounds onto it lies on the lower
+  // square's left edge, which is the equator point the upper square reaches at u = 0.
+  if (half == 1 && u == 0.5f) return {0.0f, s.y};
+  return {u, s.y};
 }
 
 /// Map coordinates (u, v) ∈ [0,1]² → unit direction (the inverse of direction_to_uv).
@@ -99,6 +105,15 @@ inline glm::vec3 uv_to_direction(const glm::vec2& uv) {
   const float scale = std::sqrt(std::max(0.0f, 2.0f - rho2));  // sin θ = ρ√(2 − ρ²)
   const float z = 1.0f - rho2;
   return {d.x * scale, d.y * scale, lower ? -z : z};
+}
+
+/// Texel (x, y) of a map of square resolution R that contains unit direction w. One function for the
+/// map's lookups and the sampler's pdf, so both always agree on the texel.
+inline void texel_of(const glm::vec3& w, int resolution, int& x, int& y) {
+  int half;
+  const glm::vec2 s = direction_to_square(w, half);
+  x = half * resolution + std::min(resolution - 1, int(s.x * float(resolution)));
+  y = std::min(resolution - 1, int(s.y * float(resolution)));
 }
 
 /// Solid angle of one texel of a map of square resolution R: 4π / (2R²) sr.
@@ -148,12 +163,7 @@ class SphereMap {
   }
 
   /// Texel that contains direction w (unit).
-  void texel_of(const glm::vec3& w, int& x, int& y) const {
-    int half;
-    const glm::vec2 s = sphere_map::direction_to_square(w, half);
-    x = half * resolution_ + std::min(resolution_ - 1, int(s.x * float(resolution_)));
-    y = std::min(resolution_ - 1, int(s.y * float(resolution_)));
-  }
+  void texel_of(const glm::vec3& w, int& x, int& y) const { sphere_map::texel_of(w, resolution_, x, y); }
 
   /// Nearest-texel value in direction w (unit): the piecewise-constant function sampling draws from.
   glm::vec3 lookup_nearest(const glm::vec3& w) const {
@@ -175,7 +185,9 @@ class SphereMap {
     const int x0 = int(fx0), y0 = int(fy0);
     const glm::vec3 v00 = fetch(half, x0, y0), v10 = fetch(half, x0 + 1, y0);
     const glm::vec3 v01 = fetch(half, x0, y0 + 1), v11 = fetch(half, x0 + 1, y0 + 1);
-    return (v00 * (1.0f - tx) + v10 * tx) * (1.0f - ty) + (v01 * (1.0f - tx) + v11 * tx) * ty;
+    // a + t·(b − a) returns a exactly when b == a, so a constant map looks up exactly constant.
+    const glm::vec3 row0 = v00 + tx * (v10 - v00), row1 = v01 + tx * (v11 - v01);
+    return row0 + ty * (row1 - row0);
   }
 
   /// Adds `flux` (per channel, e.g. W or lm) arriving in direction w to the texel containing w, as
@@ -243,12 +255,14 @@ class SphereMap {
   /// lies the mirror texel of the other square (the equator seam rule).
   glm::vec3 fetch(int half, int lx, int ly) const {
     const int R = resolution_;
-    bool flip = false;
-    if (lx < 0) lx = 0, flip = true;
-    else if (lx >= R) lx = R - 1, flip = true;
-    if (ly < 0) ly = 0, flip = true;
-    else if (ly >= R) ly = R - 1, flip = true;
-    if (flip) half ^= 1;
+    // Each edge crossed flips to the other square; past a corner both edges are crossed, which flips
+    // back (the texel diagonally past a corner is the square's own corner texel).
+    int flips = 0;
+    if (lx < 0) lx = 0, ++flips;
+    else if (lx >= R) lx = R - 1, ++flips;
+    if (ly < 0) ly = 0, ++flips;
+    else if (ly >= R) ly = R - 1, ++flips;
+    half ^= flips & 1;
     return texel(half * R + lx, ly);
   }
 
