@@ -10,20 +10,17 @@
 // metre ticks on the left and bottom; a legend row below (largest disc, a 10 % disc, the bounding sphere).
 #include "bundle_plot.h"
 
-#include <lumx/diagnostic.h>
-#include <lumx/io/atomic_file.h>
+#include "plot_canvas.h"
+
 #include <lumx/photometric_frame.h>
 
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <memory>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -32,73 +29,11 @@ LUMX_NAMESPACE_BEGIN
 
 namespace {
 
-[[noreturn]] void fail(const std::string& file, const char* field, const std::string& message) {
-  Diagnostic d;
-  d.file = file;
-  d.field = field;
-  d.message = message;
-  throw Error(std::move(d));
-}
-
-struct SurfaceDeleter {
-  void operator()(cairo_surface_t* s) const { cairo_surface_destroy(s); }
-};
-struct ContextDeleter {
-  void operator()(cairo_t* c) const { cairo_destroy(c); }
-};
-struct PatternDeleter {
-  void operator()(cairo_pattern_t* p) const { cairo_pattern_destroy(p); }
-};
-using SurfacePtr = std::unique_ptr<cairo_surface_t, SurfaceDeleter>;
-using ContextPtr = std::unique_ptr<cairo_t, ContextDeleter>;
-using PatternPtr = std::unique_ptr<cairo_pattern_t, PatternDeleter>;
-
-// cairo write callback: appends to a std::string. Must not throw across the C boundary.
-cairo_status_t append_bytes(void* closure, const unsigned char* data, unsigned int length) {
-  try {
-    static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-    return CAIRO_STATUS_SUCCESS;
-  } catch (...) {
-    return CAIRO_STATUS_NO_MEMORY;
-  }
-}
-
-struct Rgb {
-  double r, g, b;
-};
-constexpr Rgb kText{0.10, 0.10, 0.10};
-constexpr Rgb kMuted{0.38, 0.38, 0.38};
 constexpr Rgb kFrame{0.35, 0.35, 0.35};
 constexpr Rgb kGrid{0.86, 0.86, 0.86};
 constexpr Rgb kAplFill{0.96, 0.52, 0.08};
 constexpr Rgb kAplEdge{0.55, 0.22, 0.00};
 constexpr Rgb kBounds{0.07, 0.27, 0.80};
-
-std::string lower_extension(const std::string& path) {
-  const std::size_t slash = path.find_last_of("/\\");
-  const std::size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
-  std::string ext = path.substr(dot);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
-// "1234", "12.3", "0.456", "1.5e+09": no more digits than a datasheet would print.
-std::string format_quantity(double v) {
-  char buf[64];
-  const double a = std::abs(v);
-  if (a >= 1e7 || !std::isfinite(a))
-    std::snprintf(buf, sizeof buf, "%.3g", v);
-  else if (a >= 100 || a == 0)
-    std::snprintf(buf, sizeof buf, "%.0f", v);
-  else if (a >= 10)
-    std::snprintf(buf, sizeof buf, "%.1f", v);
-  else if (a >= 1)
-    std::snprintf(buf, sizeof buf, "%.2f", v);
-  else
-    std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
 
 // An azimuth in [0, 360) with at most one decimal ("12", "29.4"); 359.97 becomes "0".
 std::string format_azimuth(double deg) {
@@ -154,112 +89,42 @@ int step_decimals(double step) {
   return std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9)));
 }
 
-class Painter {
- public:
-  Painter(cairo_t* cr, std::string file) : cr_(cr), file_(std::move(file)) {}
+// The lines above a plot, from the top margin down: the optional title (bold, 1.45 × the label size), the
+// caption, and a row of labels (hemisphere names, panel titles). Baselines in px from the top of the image.
+struct HeaderLayout {
+  double label_pt = 0, title_pt = 0;
+  double title_base = 0, caption_base = 0, labels_base = 0;
+  double bottom = 0;  // below the row of labels
 
-  void check(const char* step) const {
-    const cairo_status_t st = cairo_status(cr_);
-    if (st != CAIRO_STATUS_SUCCESS)
-      fail(file_, "output", std::string("cairo failed while drawing the ") + step + ": " + cairo_status_to_string(st));
+  HeaderLayout() = default;
+  // `caption_height` and `labels_height` are the rows' heights in units of the label size.
+  HeaderLayout(double top, bool has_title, double label_size, double caption_height, double labels_height)
+      : label_pt(label_size), title_pt(1.45 * label_size) {
+    double y = top;
+    if (has_title) {
+      title_base = y + title_pt;
+      y += 1.45 * title_pt;
+    }
+    caption_base = y + label_pt;
+    y += caption_height * label_pt;
+    labels_base = y + label_pt;
+    y += labels_height * label_pt;
+    bottom = y;
   }
 
-  void color(const Rgb& c, double alpha = 1.0) const { cairo_set_source_rgba(cr_, c.r, c.g, c.b, alpha); }
-
-  void font(double size, bool bold = false) const {
-    cairo_select_font_face(cr_, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL,
-                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr_, size);
+  // Title and caption centred on x = centre_x, shrunk to `max_width` (at most to `min_font_factor`).
+  void draw(const Painter& pt, const std::string& title, const std::string& caption, double centre_x, double max_width,
+            double min_font_factor) const {
+    if (!title.empty()) {
+      pt.color(kTextColor);
+      pt.fit_font(title, title_pt, true, max_width, min_font_factor);
+      pt.text_baseline(title, centre_x, title_base, 0.5);
+    }
+    pt.color(kMutedColor);
+    pt.fit_font(caption, 0.95 * label_pt, false, max_width, min_font_factor);
+    pt.text_baseline(caption, centre_x, caption_base, 0.5);
   }
-
-  cairo_text_extents_t extents(const std::string& s) const {
-    cairo_text_extents_t e{};
-    cairo_text_extents(cr_, s.c_str(), &e);
-    return e;
-  }
-
-  // Shrinks the current font until `s` fits `max_width` (never below `min_factor` of `size`).
-  void fit_font(const std::string& s, double size, bool bold, double max_width, double min_factor = 0.55) const {
-    font(size, bold);
-    const double w = extents(s).x_advance;
-    if (w > max_width && w > 0) font(std::max(size * min_factor, size * max_width / w), bold);
-  }
-
-  // Text whose ink box is centred on (x, y).
-  void text_centered(const std::string& s, double x, double y) const {
-    const cairo_text_extents_t e = extents(s);
-    cairo_move_to(cr_, x - (e.x_bearing + e.width / 2), y - (e.y_bearing + e.height / 2));
-    cairo_show_text(cr_, s.c_str());
-  }
-
-  // Text on baseline y: align 0 = left edge at x, 0.5 = centred, 1 = right edge at x.
-  void text_baseline(const std::string& s, double x, double y, double align) const {
-    const cairo_text_extents_t e = extents(s);
-    cairo_move_to(cr_, x - align * e.x_advance, y);
-    cairo_show_text(cr_, s.c_str());
-  }
-
-  // Text vertically centred on y (by ink), horizontally aligned as in text_baseline.
-  void text_middle(const std::string& s, double x, double y, double align) const {
-    const cairo_text_extents_t e = extents(s);
-    cairo_move_to(cr_, x - align * e.x_advance, y - (e.y_bearing + e.height / 2));
-    cairo_show_text(cr_, s.c_str());
-  }
-
-  cairo_t* cr() const { return cr_; }
-
- private:
-  cairo_t* cr_;
-  std::string file_;
 };
-
-// Creates the surface (SVG stream or ARGB image), lets `draw` paint it, and writes the result atomically.
-template <class Draw>
-void render_and_write(const std::string& out_path, bool svg, double width, double height, Draw&& draw) {
-  std::string bytes;
-  SurfacePtr surface(
-      svg ? cairo_svg_surface_create_for_stream(append_bytes, &bytes, width, height)
-          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(width), static_cast<int>(height)));
-  auto check_surface = [&](const char* step) {
-    const cairo_status_t st = cairo_surface_status(surface.get());
-    if (st != CAIRO_STATUS_SUCCESS)
-      fail(out_path, "output", std::string("cairo failed to ") + step + ": " + cairo_status_to_string(st));
-  };
-  check_surface("create the surface");
-#if CAIRO_VERSION >= CAIRO_VERSION_ENCODE(1, 15, 10)
-  if (svg) cairo_svg_surface_set_document_unit(surface.get(), CAIRO_SVG_UNIT_PX);
-#endif
-  {
-    ContextPtr cr(cairo_create(surface.get()));
-    Painter painter(cr.get(), out_path);
-    painter.check("context");
-    cairo_set_antialias(cr.get(), CAIRO_ANTIALIAS_BEST);
-    cairo_set_source_rgb(cr.get(), 1, 1, 1);
-    cairo_paint(cr.get());
-    painter.check("background");
-    draw(painter);
-    painter.check("image");
-  }
-  cairo_surface_flush(surface.get());
-  check_surface("flush the image");
-  if (svg) {
-    cairo_surface_finish(surface.get());  // emits the SVG document through append_bytes
-    check_surface("finish the SVG document");
-  } else {
-    const cairo_status_t st = cairo_surface_write_to_png_stream(surface.get(), append_bytes, &bytes);
-    if (st != CAIRO_STATUS_SUCCESS)
-      fail(out_path, "output", std::string("cairo failed to encode the PNG: ") + cairo_status_to_string(st));
-  }
-  if (bytes.empty()) fail(out_path, "output", "cairo produced no image data");
-  write_file_atomically(out_path, bytes);
-}
-
-bool image_format(const std::string& out_path) {
-  const std::string ext = lower_extension(out_path);
-  if (ext != ".svg" && ext != ".png")
-    fail(out_path, "output", "cannot tell the image format from the extension '" + ext + "' (use .svg or .png)");
-  return ext == ".svg";
-}
 
 // ---------------------------------------------------------------------------------------------------------
 // Sphere-map image
@@ -331,7 +196,7 @@ std::vector<Tick> bar_ticks(const ToneMap& tm) {
   for (int i = 0;; ++i) {
     const double v = i * step;
     if (v > hi * (1 + 1e-9)) break;
-    out.push_back({v / hi, true, hi >= 100 ? format_quantity(v) : format_tick(v, dec)});
+    out.push_back({v / hi, true, hi >= 100 ? format_quantity_compact(v) : format_tick(v, dec)});
     if (i > 100) break;
   }
   return out;
@@ -371,20 +236,10 @@ class MapRenderer {
     lw_ = std::max(1.0, cw_ / 1000.0);
     m_ = std::round(std::max(12.0, 0.025 * cw_));
     W_ = std::ceil(cw_ + 2 * m_);
-    title_pt_ = 1.45 * label_pt_;
-
-    double y = m_;
-    if (!o.title.empty()) {
-      title_base_ = y + title_pt_;
-      y += 1.45 * title_pt_;
-    }
-    caption_base_ = y + label_pt_;
-    y += 1.9 * label_pt_;
-    hemi_base_ = y + label_pt_;
-    y += 1.6 * label_pt_;
+    header_ = HeaderLayout(m_, !o.title.empty(), label_pt_, 1.9, 1.6);
     img_x_ = std::round(m_ + 0.5 * (cw_ - img_w_));
-    img_y_ = std::round(y);
-    y = img_y_ + side_ + 1.1 * label_pt_;
+    img_y_ = std::round(header_.bottom);
+    double y = img_y_ + side_ + 1.1 * label_pt_;
     bar_y_ = std::round(y);
     bar_h_ = std::round(1.1 * label_pt_);
     y = bar_y_ + bar_h_ + 0.4 * label_pt_;
@@ -406,16 +261,11 @@ class MapRenderer {
 
  private:
   void draw_header(Painter& pt) const {
-    pt.color(kText);
-    if (!o_.title.empty()) {
-      pt.fit_font(o_.title, title_pt_, true, cw_);
-      pt.text_baseline(o_.title, 0.5 * W_, title_base_, 0.5);
-    }
     std::string cap;
     if (tm_.all_zero) {
       cap = "all zero";
     } else {
-      cap = "peak " + format_quantity(peak_) + " " + o_.unit;
+      cap = "peak " + format_quantity_compact(peak_) + " " + o_.unit;
       const glm::vec3 w = sphere_map::uv_to_direction(
           glm::vec2((peak_x_ + 0.5f) / float(map_.width()), (peak_y_ + 0.5f) / float(map_.height())));
       const PhotometricAngles a = angles_from_direction(PhotometricType::C, glm::dvec3(w));
@@ -425,25 +275,23 @@ class MapRenderer {
     cap += "   ·   " + std::to_string(map_.width()) + " × " + std::to_string(map_.height()) + " texels, " +
            (map_.channels() == 1 ? "1 channel" : "RGB (Rec. 709 Y)");
     if (bad_ > 0) cap += "   ·   " + std::to_string(bad_) + " NaN/negative texels shown as 0";
-    pt.color(kMuted);
-    pt.fit_font(cap, 0.95 * label_pt_, false, cw_);
-    pt.text_baseline(cap, 0.5 * W_, caption_base_, 0.5);
+    header_.draw(pt, o_.title, cap, 0.5 * W_, cw_, 0.55);
 
     // Hemisphere names, centred over their squares unless the squares are too narrow for that.
     const std::string up = "upper hemisphere (z ≥ 0)", down = "lower hemisphere (z < 0)";
-    pt.color(kText);
+    pt.color(kTextColor);
     pt.font(label_pt_, true);
     const double wu = pt.extents(up).x_advance, wd = pt.extents(down).x_advance;
     const double cl = img_x_ + 0.5 * side_, cr = img_x_ + side_ + gap_ + 0.5 * side_;
     if (cl + 0.5 * wu + label_pt_ < cr - 0.5 * wd) {
-      pt.text_baseline(up, cl, hemi_base_, 0.5);
-      pt.text_baseline(down, cr, hemi_base_, 0.5);
+      pt.text_baseline(up, cl, header_.labels_base, 0.5);
+      pt.text_baseline(down, cr, header_.labels_base, 0.5);
     } else {
       const double mid = img_x_ + side_ + 0.5 * gap_;
       pt.fit_font(up, label_pt_, true, 0.5 * cw_ - label_pt_);
-      pt.text_baseline(up, mid - 0.5 * label_pt_, hemi_base_, 1);
+      pt.text_baseline(up, mid - 0.5 * label_pt_, header_.labels_base, 1);
       pt.fit_font(down, label_pt_, true, 0.5 * cw_ - label_pt_);
-      pt.text_baseline(down, mid + 0.5 * label_pt_, hemi_base_, 0);
+      pt.text_baseline(down, mid + 0.5 * label_pt_, header_.labels_base, 0);
     }
     pt.check("title");
   }
@@ -476,9 +324,9 @@ class MapRenderer {
     const int f = svg ? s_ : 1;
     SurfacePtr img = make_texels(f);
     if (cairo_surface_status(img.get()) != CAIRO_STATUS_SUCCESS)
-      fail("", "output",
-           std::string("cairo failed to create the texel image: ") +
-               cairo_status_to_string(cairo_surface_status(img.get())));
+      throw_plot_error("", "output",
+                       std::string("cairo failed to create the texel image: ") +
+                           cairo_status_to_string(cairo_surface_status(img.get())));
     for (int half = 0; half < 2; ++half) {
       const double x0 = img_x_ + half * (side_ + gap_);
       cairo_save(cr);
@@ -543,20 +391,20 @@ class MapRenderer {
       if (!t.label.empty()) {
         const double w = pt.extents(t.label).x_advance;
         if (x - 0.5 * w < last_right + 0.5 * label_pt_) continue;  // would overlap the previous label
-        pt.color(kText);
+        pt.color(kTextColor);
         pt.text_baseline(t.label, x, ticks_base_, 0.5);
         last_right = x + 0.5 * w;
       }
     }
     if (!unit.empty()) {
-      pt.color(kText);
+      pt.color(kTextColor);
       pt.font(label_pt_, true);
       pt.text_middle(unit, x1 + 1.5 * label_pt_, bar_y_ + 0.5 * bar_h_, 0);
     }
     const std::string note = tm_.all_zero ? "all zero: the bar shows 0..1"
                                           : "each square is equal-area: pole at the centre, horizon at the edge; "
                                             "C0 to the right, C90 downwards";
-    pt.color(kMuted);
+    pt.color(kMutedColor);
     pt.fit_font(note, 0.85 * label_pt_, false, cw_);
     pt.text_baseline(note, 0.5 * W_, note_base_, 0.5);
     pt.check("colour bar");
@@ -570,9 +418,9 @@ class MapRenderer {
   int peak_x_ = 0, peak_y_ = 0;
   std::size_t bad_ = 0;
   ToneMap tm_;
-  double side_, cw_, label_pt_, gap_, img_w_, lw_, m_, W_, H_ = 0, title_pt_;
-  double title_base_ = 0, caption_base_ = 0, hemi_base_ = 0, img_x_ = 0, img_y_ = 0, bar_y_ = 0, bar_h_ = 0,
-         ticks_base_ = 0, note_base_ = 0;
+  double side_, cw_, label_pt_, gap_, img_w_, lw_, m_, W_, H_ = 0;
+  HeaderLayout header_;
+  double img_x_ = 0, img_y_ = 0, bar_y_ = 0, bar_h_ = 0, ticks_base_ = 0, note_base_ = 0;
 };
 
 // ---------------------------------------------------------------------------------------------------------
@@ -641,19 +489,9 @@ class AplRenderer {
     W_ = S_;
     m_ = std::round(std::max(10.0, 0.02 * S_));
     label_pt_ = std::max(8.0, 0.0125 * S_);
-    title_pt_ = 1.45 * label_pt_;
     gap_ = 1.2 * label_pt_;
-
-    double y = m_;
-    if (!o.title.empty()) {
-      title_base_ = y + title_pt_;
-      y += 1.45 * title_pt_;
-    }
-    caption_base_ = y + label_pt_;
-    y += 2.0 * label_pt_;
-    panel_title_base_ = y + label_pt_;
-    y += 1.7 * label_pt_;
-    plot_y_ = std::round(y);
+    header_ = HeaderLayout(m_, !o.title.empty(), label_pt_, 2.0, 1.7);
+    plot_y_ = std::round(header_.bottom);
   }
 
   // Fixes the horizontal layout; needs a context to measure the tick labels.
@@ -718,20 +556,36 @@ class AplRenderer {
   }
   double radius(double f) const { return fmax_ > 0 ? std::max(1.5, r_max_ * std::sqrt(f / fmax_)) : 1.5; }
 
+  // One APL (in a panel or the legend): a translucent orange disc with a darker edge; lw = base line width.
+  static void draw_apl_disc(const Painter& pt, double x, double y, double r, double lw) {
+    cairo_t* cr = pt.cr();
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, x, y, r, 0, 2 * kPi);
+    pt.color(kAplFill, 0.55);
+    cairo_fill_preserve(cr);
+    pt.color(kAplEdge, 0.85);
+    cairo_set_line_width(cr, 0.8 * lw);
+    cairo_stroke(cr);
+  }
+
+  // Strokes the current path as the bounding sphere is drawn (in a panel or the legend): dashed blue.
+  static void stroke_as_bounds(const Painter& pt, double lw) {
+    cairo_t* cr = pt.cr();
+    const double d[] = {5 * lw, 3.5 * lw};
+    cairo_set_dash(cr, d, 2, 0);
+    cairo_set_line_width(cr, 1.3 * lw);
+    pt.color(kBounds, 0.8);
+    cairo_stroke(cr);
+    cairo_set_dash(cr, nullptr, 0, 0);
+  }
+
   void draw_header(Painter& pt) const {
-    if (!o_.title.empty()) {
-      pt.color(kText);
-      pt.fit_font(o_.title, title_pt_, true, W_ - 2 * m_, 0.35);
-      pt.text_baseline(o_.title, 0.5 * W_, title_base_, 0.5);
-    }
     std::string cap = std::to_string(count_) + (count_ == 1 ? " APL" : " APLs") + "   ·   Σ flux " +
-                      format_quantity(total_) + " " + o_.flux_unit;
+                      format_quantity_compact(total_) + " " + o_.flux_unit;
     if (show_bounds_) cap += "   ·   bounding sphere r = " + format_metres(bounds_.radius);
     cap += "   ·   grid " + format_metres(step_);
     if (skipped_ > 0) cap += "   ·   " + std::to_string(skipped_) + " with non-finite or absurd positions not drawn";
-    pt.color(kMuted);
-    pt.fit_font(cap, 0.95 * label_pt_, false, W_ - 2 * m_, 0.35);
-    pt.text_baseline(cap, 0.5 * W_, caption_base_, 0.5);
+    header_.draw(pt, o_.title, cap, 0.5 * W_, W_ - 2 * m_, 0.35);
     pt.check("title");
   }
 
@@ -741,9 +595,9 @@ class AplRenderer {
     const double x0 = panel_x(i), y0 = plot_y_;
     const double lw = std::max(1.0, S_ / 1000.0);
 
-    pt.color(kText);
+    pt.color(kTextColor);
     pt.fit_font(v.name, label_pt_, true, p_ + std::min(gap_, 2 * m_), 0.35);
-    pt.text_baseline(v.name, x0 + 0.5 * p_, panel_title_base_, 0.5);
+    pt.text_baseline(v.name, x0 + 0.5 * p_, header_.labels_base, 0.5);
 
     cairo_rectangle(cr, x0, y0, p_, p_);
     cairo_set_source_rgb(cr, 0.985, 0.985, 0.985);
@@ -776,12 +630,7 @@ class AplRenderer {
       project(i, bounds_.center, cx, cy);
       cairo_new_sub_path(cr);
       cairo_arc(cr, cx, cy, bounds_.radius * scale_, 0, 2 * kPi);
-      const double d[] = {5 * lw, 3.5 * lw};
-      cairo_set_dash(cr, d, 2, 0);
-      cairo_set_line_width(cr, 1.3 * lw);
-      pt.color(kBounds, 0.8);
-      cairo_stroke(cr);
-      cairo_set_dash(cr, nullptr, 0, 0);
+      stroke_as_bounds(pt, lw);
       const double c = 0.4 * label_pt_;  // centre mark
       cairo_move_to(cr, cx - c, cy);
       cairo_line_to(cr, cx + c, cy);
@@ -796,16 +645,10 @@ class AplRenderer {
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
       return v.depth_sign * pos_[a][v.depth] < v.depth_sign * pos_[b][v.depth];
     });
-    cairo_set_line_width(cr, 0.8 * lw);
     for (std::size_t k : order) {
       double x, y;
       project(i, pos_[k], x, y);
-      cairo_new_sub_path(cr);
-      cairo_arc(cr, x, y, radius(flux_[k]), 0, 2 * kPi);
-      pt.color(kAplFill, 0.55);
-      cairo_fill_preserve(cr);
-      pt.color(kAplEdge, 0.85);
-      cairo_stroke(cr);
+      draw_apl_disc(pt, x, y, radius(flux_[k]), lw);
     }
     cairo_restore(cr);
     pt.check("APLs");
@@ -828,7 +671,7 @@ class AplRenderer {
       const std::string s = format_tick(t, decimals_);
       const double w = pt.extents(s).x_advance;
       if (x - 0.5 * w < last_right + 0.4 * label_pt_) continue;
-      pt.color(kText);
+      pt.color(kTextColor);
       pt.text_baseline(s, x, tick_base_, 0.5);
       last_right = x + 0.5 * w;
     }
@@ -838,11 +681,11 @@ class AplRenderer {
       cairo_line_to(cr, x0 - tl, y);
       pt.color(kFrame);
       cairo_stroke(cr);
-      pt.color(kText);
+      pt.color(kTextColor);
       pt.text_middle(format_tick(t, decimals_), x0 - tl - 0.25 * label_pt_, y, 1);
     }
     pt.font(label_pt_);
-    pt.color(kText);
+    pt.color(kTextColor);
     pt.text_baseline(v.u_label, x0 + 0.5 * p_, axis_label_base_, 0.5);
     cairo_save(cr);
     cairo_translate(cr, x0 - gutter_ + 0.9 * label_pt_, y0 + 0.5 * p_);
@@ -868,9 +711,9 @@ class AplRenderer {
     if (pos_.empty()) {
       items.push_back({"no APL to draw", -1, 0});
     } else {
-      items.push_back({"largest APL: " + format_quantity(fmax_) + " " + o_.flux_unit, radius(fmax_), 0});
+      items.push_back({"largest APL: " + format_quantity_compact(fmax_) + " " + o_.flux_unit, radius(fmax_), 0});
       if (fmax_ > 0 && radius(0.1 * fmax_) > 1.5)
-        items.push_back({"10 %: " + format_quantity(0.1 * fmax_) + " " + o_.flux_unit, radius(0.1 * fmax_), 0});
+        items.push_back({"10 %: " + format_quantity_compact(0.1 * fmax_) + " " + o_.flux_unit, radius(0.1 * fmax_), 0});
       items.push_back({"disc area ∝ flux (at least 1.5 px)", -1, 0});
     }
     if (show_bounds_) items.push_back({"bounding sphere", 0, 0});
@@ -906,26 +749,15 @@ class AplRenderer {
       for (const LegendItem& it : row.items) {
         const double x_end = x + it.width;
         if (it.r > 0) {
-          cairo_new_sub_path(cr);
-          cairo_arc(cr, x + it.r, y, it.r, 0, 2 * kPi);
-          pt.color(kAplFill, 0.55);
-          cairo_fill_preserve(cr);
-          pt.color(kAplEdge, 0.85);
-          cairo_set_line_width(cr, 0.8 * lw);
-          cairo_stroke(cr);
+          draw_apl_disc(pt, x + it.r, y, it.r, lw);
           x += 2 * it.r + inner;
         } else if (it.r == 0) {
           cairo_move_to(cr, x, y);
           cairo_line_to(cr, x + sample, y);
-          const double d[] = {5 * lw, 3.5 * lw};
-          cairo_set_dash(cr, d, 2, 0);
-          cairo_set_line_width(cr, 1.3 * lw);
-          pt.color(kBounds, 0.8);
-          cairo_stroke(cr);
-          cairo_set_dash(cr, nullptr, 0, 0);
+          stroke_as_bounds(pt, lw);
           x += sample + inner;
         }
-        pt.color(it.r < 0 ? kMuted : kText);
+        pt.color(it.r < 0 ? kMutedColor : kTextColor);
         pt.text_middle(it.text, x, y, 0);
         x = x_end + between;
       }
@@ -942,8 +774,9 @@ class AplRenderer {
   bool show_bounds_ = false;
   glm::dvec3 centre_{0.0};
   double half_ = 0;
-  double S_, W_, H_ = 0, m_, label_pt_, title_pt_, gap_;
-  double title_base_ = 0, caption_base_ = 0, panel_title_base_ = 0, plot_y_ = 0;
+  double S_, W_, H_ = 0, m_, label_pt_, gap_;
+  HeaderLayout header_;
+  double plot_y_ = 0;
   double p_ = 0, r_max_ = 0, scale_ = 1, visible_half_ = 1, step_ = 1, gutter_ = 0;
   int decimals_ = 0;
   double tick_base_ = 0, axis_label_base_ = 0;
@@ -952,25 +785,25 @@ class AplRenderer {
 }  // namespace
 
 void write_sphere_map_image(const SphereMap& map, const std::string& out_path, const MapImageOptions& o) {
-  const bool svg = image_format(out_path);
-  if (map.empty() || map.resolution() < 1) fail(out_path, "map", "the sphere map is empty");
-  if (o.scale < 0) fail(out_path, "scale", "scale " + std::to_string(o.scale) + " is negative");
+  const bool svg = is_svg_output(out_path);
+  if (map.empty() || map.resolution() < 1) throw_plot_error(out_path, "map", "the sphere map is empty");
+  if (o.scale < 0) throw_plot_error(out_path, "scale", "scale " + std::to_string(o.scale) + " is negative");
   const int tw = map.width();
   const int scale = o.scale > 0 ? o.scale : std::max(1, static_cast<int>(std::lround(1024.0 / tw)));
   if (static_cast<long long>(scale) * tw > kMaxImageWidth)
-    fail(out_path, "scale",
-         "scale " + std::to_string(scale) + " would make the image " +
-             std::to_string(static_cast<long long>(scale) * tw) + " px wide (at most " +
-             std::to_string(kMaxImageWidth) + ")");
+    throw_plot_error(out_path, "scale",
+                     "scale " + std::to_string(scale) + " would make the image " +
+                         std::to_string(static_cast<long long>(scale) * tw) + " px wide (at most " +
+                         std::to_string(kMaxImageWidth) + ")");
   const MapRenderer renderer(map, o, scale);
   render_and_write(out_path, svg, renderer.width(), renderer.height(), [&](Painter& pt) { renderer.draw(pt, svg); });
 }
 
 void write_apl_positions_plot(const AplLevel& level, ChannelLayout channels, const BoundingSphere& bounds,
                               const std::string& out_path, const AplPlotOptions& o) {
-  const bool svg = image_format(out_path);
+  const bool svg = is_svg_output(out_path);
   if (o.size_px < 300 || o.size_px > 8000)
-    fail(out_path, "size", "plot size " + std::to_string(o.size_px) + " px is outside 300..8000");
+    throw_plot_error(out_path, "size", "plot size " + std::to_string(o.size_px) + " px is outside 300..8000");
   AplRenderer renderer(level, channels, bounds, o);
   {
     // Measure the tick labels on a scratch surface to fix the layout (and so the image height).

@@ -7,19 +7,15 @@
 // that crosses the curves least (near the zenith for a downlight), on a translucent white box.
 #include "polar_plot.h"
 
-#include <lumx/diagnostic.h>
-#include <lumx/io/atomic_file.h>
+#include "plot_canvas.h"
+
 #include <lumx/polar_diagram.h>
 
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <memory>
-#include <new>
 #include <string>
 #include <vector>
 
@@ -27,64 +23,8 @@ LUMX_NAMESPACE_BEGIN
 
 namespace {
 
-[[noreturn]] void fail(const std::string& file, const char* field, const std::string& message) {
-  Diagnostic d;
-  d.file = file;
-  d.field = field;
-  d.message = message;
-  throw Error(std::move(d));
-}
-
-struct SurfaceDeleter {
-  void operator()(cairo_surface_t* s) const { cairo_surface_destroy(s); }
-};
-struct ContextDeleter {
-  void operator()(cairo_t* c) const { cairo_destroy(c); }
-};
-using SurfacePtr = std::unique_ptr<cairo_surface_t, SurfaceDeleter>;
-using ContextPtr = std::unique_ptr<cairo_t, ContextDeleter>;
-
-// cairo write callback: appends to a std::string. Must not throw across the C boundary.
-cairo_status_t append_bytes(void* closure, const unsigned char* data, unsigned int length) {
-  try {
-    static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-    return CAIRO_STATUS_SUCCESS;
-  } catch (...) {
-    return CAIRO_STATUS_NO_MEMORY;
-  }
-}
-
-struct Rgb {
-  double r, g, b;
-};
 constexpr Rgb kC0Color{0.80, 0.07, 0.07};   // C0-C180: red, solid
 constexpr Rgb kC90Color{0.07, 0.27, 0.80};  // C90-C270: blue, dashed
-constexpr Rgb kText{0.10, 0.10, 0.10};
-constexpr Rgb kMuted{0.38, 0.38, 0.38};
-
-std::string lower_extension(const std::string& path) {
-  const std::size_t slash = path.find_last_of("/\\");
-  const std::size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
-  std::string ext = path.substr(dot);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
-// "1234", "12.3", "0.456": no more digits than a datasheet would print.
-std::string format_quantity(double v) {
-  char buf[64];
-  const double a = std::abs(v);
-  if (a >= 100 || a == 0)
-    std::snprintf(buf, sizeof buf, "%.0f", v);
-  else if (a >= 10)
-    std::snprintf(buf, sizeof buf, "%.1f", v);
-  else if (a >= 1)
-    std::snprintf(buf, sizeof buf, "%.2f", v);
-  else
-    std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
 
 std::string format_angle(double deg) {
   char buf[32];
@@ -94,59 +34,6 @@ std::string format_angle(double deg) {
     std::snprintf(buf, sizeof buf, "%.1f", deg);
   return buf;
 }
-
-class Painter {
- public:
-  Painter(cairo_t* cr, std::string file) : cr_(cr), file_(std::move(file)) {}
-
-  void check(const char* step) const {
-    const cairo_status_t st = cairo_status(cr_);
-    if (st != CAIRO_STATUS_SUCCESS)
-      fail(file_, "output",
-           std::string("cairo failed while drawing the ") + step + ": " + cairo_status_to_string(st));
-  }
-
-  void color(const Rgb& c, double alpha = 1.0) const { cairo_set_source_rgba(cr_, c.r, c.g, c.b, alpha); }
-
-  void font(double size, bool bold = false) const {
-    cairo_select_font_face(cr_, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL,
-                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr_, size);
-  }
-
-  cairo_text_extents_t extents(const std::string& s) const {
-    cairo_text_extents_t e{};
-    cairo_text_extents(cr_, s.c_str(), &e);
-    return e;
-  }
-
-  // Shrinks the current font until `s` fits `max_width` (never below 55 % of `size`).
-  void fit_font(const std::string& s, double size, bool bold, double max_width) const {
-    font(size, bold);
-    const double w = extents(s).x_advance;
-    if (w > max_width && w > 0) font(std::max(size * 0.55, size * max_width / w), bold);
-  }
-
-  // Text whose ink box is centred on (x, y).
-  void text_centered(const std::string& s, double x, double y) const {
-    const cairo_text_extents_t e = extents(s);
-    cairo_move_to(cr_, x - (e.x_bearing + e.width / 2), y - (e.y_bearing + e.height / 2));
-    cairo_show_text(cr_, s.c_str());
-  }
-
-  // Text on baseline y: align 0 = left edge at x, 0.5 = centred, 1 = right edge at x.
-  void text_baseline(const std::string& s, double x, double y, double align) const {
-    const cairo_text_extents_t e = extents(s);
-    cairo_move_to(cr_, x - align * e.x_advance, y);
-    cairo_show_text(cr_, s.c_str());
-  }
-
-  cairo_t* cr() const { return cr_; }
-
- private:
-  cairo_t* cr_;
-  std::string file_;
-};
 
 struct Box {
   double x0, y0, x1, y1;
@@ -172,11 +59,8 @@ class PolarRenderer {
   double width() const { return W_; }
   double height() const { return H_; }
 
+  // Draws on a white surface of width() × height().
   void draw(Painter& pt) const {
-    cairo_t* cr = pt.cr();
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    cairo_paint(cr);
-    pt.check("background");
     draw_header(pt);
     draw_grid(pt);
     draw_curve(pt, dg_.c0_c180, kC0Color, false);
@@ -196,7 +80,7 @@ class PolarRenderer {
   }
 
   void draw_header(Painter& pt) const {
-    pt.color(kText);
+    pt.color(kTextColor);
     pt.fit_font(title_, 0.030 * S_, true, 0.94 * W_);
     pt.text_baseline(title_, 0.5 * W_, 0.050 * S_, 0.5);
 
@@ -216,7 +100,7 @@ class PolarRenderer {
       pt.font(cap_pt);
       if (pt.extents(with_file).x_advance <= cap_width / 0.85) cap = with_file;
     }
-    pt.color(kMuted);
+    pt.color(kMutedColor);
     pt.fit_font(cap, cap_pt, false, cap_width);
     pt.text_baseline(cap, 0.5 * W_, 0.087 * S_, 0.5);
     pt.check("title");
@@ -253,7 +137,7 @@ class PolarRenderer {
       cairo_stroke(cr);
     }
     // Angle labels every 30 degrees, on both halves; 0 at nadir, 180 at the zenith.
-    pt.color(kText);
+    pt.color(kTextColor);
     for (const auto& [b, text] : angle_label_boxes(pt))
       pt.text_centered(text, 0.5 * (b.x0 + b.x1), 0.5 * (b.y0 + b.y1));
     pt.check("grid");
@@ -377,7 +261,7 @@ class PolarRenderer {
       cairo_rectangle(cr, b.x0, b.y0, b.x1 - b.x0, b.y1 - b.y0);
       cairo_set_source_rgba(cr, 1, 1, 1, 0.82);
       cairo_fill(cr);
-      pt.color(kMuted);
+      pt.color(kMutedColor);
       pt.text_centered(s, 0.5 * (b.x0 + b.x1), 0.5 * (b.y0 + b.y1));
     }
     pt.check("ring labels");
@@ -394,7 +278,7 @@ class PolarRenderer {
     pt.text_baseline(dg_.c90_c270.negative_side, cx_ - R_, top + 1.35 * label_pt_, 0);
     pt.text_baseline(dg_.c90_c270.positive_side, cx_ + R_, top + 1.35 * label_pt_, 1);
 
-    pt.color(kText);
+    pt.color(kTextColor);
     pt.font(1.15 * label_pt_, true);
     pt.text_baseline(dg_.unit, cx_ - R_, bottom, 0);
     if (dg_.relative && dg_.rated_lamp_flux_lm > 0) {
@@ -433,7 +317,7 @@ class PolarRenderer {
       pt.color(it.col);
       cairo_stroke(cr);
       cairo_set_dash(cr, nullptr, 0, 0);
-      pt.color(kText);
+      pt.color(kTextColor);
       const cairo_text_extents_t e = pt.extents(it.c->name);
       cairo_move_to(cr, x + seg + gap, y - (e.y_bearing + e.height / 2));
       cairo_show_text(cr, it.c->name.c_str());
@@ -451,53 +335,16 @@ class PolarRenderer {
 }  // namespace
 
 void write_polar_plot(const Photometry& p, const std::string& out_path, const PolarPlotOptions& opts) {
-  const std::string ext = lower_extension(out_path);
-  const bool svg = ext == ".svg";
-  if (!svg && ext != ".png")
-    fail(out_path, "output", "cannot tell the image format from the extension '" + ext + "' (use .svg or .png)");
+  const bool svg = is_svg_output(out_path);
   if (opts.size_px < 200 || opts.size_px > 8000)
-    fail(out_path, "size", "plot size " + std::to_string(opts.size_px) + " px is outside 200..8000");
+    throw_plot_error(out_path, "size", "plot size " + std::to_string(opts.size_px) + " px is outside 200..8000");
 
   PolarDiagramOptions dopt;
   dopt.force_cd = opts.force_cd;
   const PolarDiagram dg = make_polar_diagram(p, dopt);
   const PolarRenderer renderer(dg, opts.title.empty() ? dg.title : opts.title, p.type == PhotometricType::C,
                                opts.size_px);
-
-  std::string bytes;
-  SurfacePtr surface(svg ? cairo_svg_surface_create_for_stream(append_bytes, &bytes, renderer.width(),
-                                                                 renderer.height())
-                         : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(renderer.width()),
-                                                      static_cast<int>(renderer.height())));
-  auto check_surface = [&](const char* step) {
-    const cairo_status_t st = cairo_surface_status(surface.get());
-    if (st != CAIRO_STATUS_SUCCESS)
-      fail(out_path, "output", std::string("cairo failed to ") + step + ": " + cairo_status_to_string(st));
-  };
-  check_surface("create the surface");
-#if CAIRO_VERSION >= CAIRO_VERSION_ENCODE(1, 15, 10)
-  if (svg) cairo_svg_surface_set_document_unit(surface.get(), CAIRO_SVG_UNIT_PX);
-#endif
-  {
-    ContextPtr cr(cairo_create(surface.get()));
-    Painter painter(cr.get(), out_path);
-    painter.check("context");
-    cairo_set_antialias(cr.get(), CAIRO_ANTIALIAS_BEST);
-    renderer.draw(painter);
-    painter.check("diagram");
-  }
-  cairo_surface_flush(surface.get());
-  check_surface("flush the image");
-  if (svg) {
-    cairo_surface_finish(surface.get());  // emits the SVG document through append_bytes
-    check_surface("finish the SVG document");
-  } else {
-    const cairo_status_t st = cairo_surface_write_to_png_stream(surface.get(), append_bytes, &bytes);
-    if (st != CAIRO_STATUS_SUCCESS)
-      fail(out_path, "output", std::string("cairo failed to encode the PNG: ") + cairo_status_to_string(st));
-  }
-  if (bytes.empty()) fail(out_path, "output", "cairo produced no image data");
-  write_file_atomically(out_path, bytes);
+  render_and_write(out_path, svg, renderer.width(), renderer.height(), [&](Painter& pt) { renderer.draw(pt); });
 }
 
 LUMX_NAMESPACE_END

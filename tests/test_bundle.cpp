@@ -15,6 +15,8 @@
 #include <fstream>
 #include <random>
 
+#include "io/exr_image.h"
+#include "io/sha256.h"
 #include "test_support.h"
 
 using namespace lumx;
@@ -268,6 +270,35 @@ TEST(Bundle, CorruptedPayloadsAreRejectedWithTheirLocation) {
     const auto findings = check_bundle(b.string());
     ASSERT_EQ(findings.size(), 1u);
     EXPECT_NE(findings[0].str().find("payload missing"), std::string::npos);
+  }
+}
+
+TEST(Bundle, NanOrNegativeTexelsWithValidChecksumsAreRejected) {
+  // A payload that is a well-formed EXR with a correct checksum, but holds NaN (or a negative value):
+  // the reader names the APL and texel.
+  const fs::path root = scratch("nan_payload");
+  const fs::path good = root / "good.lumx";
+  write_bundle(good.string(), three_level_set(8, ChannelLayout::luminance));
+  for (float bad : {NAN, -1.0f}) {
+    const fs::path b = root / (std::isnan(bad) ? "nan.lumx" : "negative.lumx");
+    fs::copy(good, b, fs::copy_options::recursive);
+    nlohmann::json j = read_manifest(b);
+    const BundleLevelInfo info = BundleReader(b.string()).manifest().levels[1];
+    detail::ExrImage image;
+    image.width = 2 * 8;
+    image.height = 8 * int(info.apl_count());
+    image.channels = {"Y"};
+    image.half = false;
+    image.pixels.assign(std::size_t(image.width) * image.height, 1.0f);
+    image.pixels[std::size_t(3 * 8 + 2) * image.width + 5] = bad;  // APL 3, texel (5, 2)
+    const std::string bytes = detail::encode_exr(image);
+    spit(b / std::string(j["levels"][1]["maps"][0]["file"]), bytes);
+    j["levels"][1]["maps"][0]["bytes"] = bytes.size();
+    j["levels"][1]["maps"][0]["sha256"] = detail::sha256_hex(bytes);
+    j["levels"][1]["maps"][0]["pixel_type"] = "float";
+    write_manifest(b, j);
+    const std::string e = load_error(b);
+    EXPECT_NE(e.find("APL 3 texel (5, 2)"), std::string::npos) << e;
   }
 }
 

@@ -80,6 +80,16 @@ class Error : public std::runtime_error {
   Diagnostic diag_;
 };
 
+/// Convenience: throw an Error about a field of a file without line numbers (binary files, folders, JSON
+/// located by a pointer in `field`).
+[[noreturn]] inline void throw_at_field(const std::string& file, std::string field, std::string message) {
+  Diagnostic d;
+  d.file = file;
+  d.field = std::move(field);
+  d.message = std::move(message);
+  throw Error(std::move(d));
+}
+
 /// Convenience: throw an Error located at a line of a text file.
 [[noreturn]] inline void throw_at_line(const std::string& file, int line, std::string field,
                                        std::string message) {

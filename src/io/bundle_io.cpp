@@ -28,11 +28,7 @@ namespace {
 constexpr float kHalfMax = 65504.0f;
 
 [[noreturn]] void fail(const std::string& file, const std::string& field, const std::string& message) {
-  Diagnostic d;
-  d.file = file;
-  d.field = field;
-  d.message = message;
-  throw Error(std::move(d));
+  throw_at_field(file, field, message);
 }
 
 std::string join(const std::string& folder, const std::string& relative) { return (fs::path(folder) / relative).string(); }

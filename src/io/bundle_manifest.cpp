@@ -55,11 +55,7 @@ class Reader {
   Reader(std::string file) : file_(std::move(file)) {}
 
   [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
-    Diagnostic d;
-    d.file = file_;
-    d.field = pointer.empty() ? "/" : pointer;
-    d.message = message;
-    throw Error(std::move(d));
+    throw_at_field(file_, pointer.empty() ? "/" : pointer, message);
   }
   const json& member(const json& obj, const std::string& pointer, const char* key) const {
     if (!obj.is_object()) fail(pointer, "expected an object");

@@ -58,11 +58,7 @@ class MemoryIStream : public Imf::IStream {
 };
 
 [[noreturn]] void fail(const std::string& file, const std::string& field, const std::string& message) {
-  Diagnostic d;
-  d.file = file;
-  d.field = field;
-  d.message = message;
-  throw Error(std::move(d));
+  throw_at_field(file, field, message);
 }
 
 }  // namespace
