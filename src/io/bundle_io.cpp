@@ -276,6 +276,11 @@ AplLevel BundleReader::load_level(std::size_t k, int max_resolution) const {
     if (!a.map.all_finite_nonnegative(&bx, &by, &bc))
       fail(file, "APL " + std::to_string(i) + " texel (" + std::to_string(bx) + ", " + std::to_string(by) + ")",
            "negative or not finite");
+  }
+  // Values first (above), then consistency with the manifest: a NaN is reported as itself, not as the
+  // flux mismatch it causes.
+  for (std::size_t i = 0; i < n; ++i) {
+    const Apl& a = level.apls[i];
     // The manifest's flux must be the map's integral (half keeps 2^-11 relative per texel; see choose_half).
     const double map_flux = luminance_of(manifest_.channels, a.map.integral());
     const double stated = luminance_of(manifest_.channels, a.flux);
