@@ -13,6 +13,7 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cstddef>
 
 LUMX_NAMESPACE_BEGIN
@@ -56,22 +57,38 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
   const float min_r = float(detail::effective_min_distance(set, options));
   IrradianceResult result;
   glm::vec3 sum(0.0f);
-  for (std::size_t i = 0; i < level.apls.size(); ++i) {
-    const Apl& a = level.apls[i];
-    const glm::vec3 d = x - a.position;
-    float r2 = glm::dot(d, d);
-    float r = std::sqrt(r2);
-    glm::vec3 w = r > 0 ? d / r : glm::vec3(0, 0, -1);  // at the APL itself: an arbitrary but fixed direction
-    if (r < min_r) {
-      r = min_r;
-      r2 = min_r * min_r;
-      ++result.clamped;
+  // Two passes per chunk of APLs: first every direction, weight and texel footprint (prefetching the
+  // texels), then the blends. With hundreds of maps in DRAM the misses of a chunk overlap instead of
+  // being paid one after another (performance.md §3c: the limit is misses in flight, not bandwidth).
+  constexpr std::size_t kChunk = 32;
+  SphereMap::Footprint footprints[kChunk];
+  float weights[kChunk];
+  std::size_t index[kChunk];
+  for (std::size_t begin = 0; begin < level.apls.size(); begin += kChunk) {
+    const std::size_t end = std::min(level.apls.size(), begin + kChunk);
+    std::size_t count = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Apl& a = level.apls[i];
+      const glm::vec3 d = x - a.position;
+      float r2 = glm::dot(d, d);
+      float r = std::sqrt(r2);
+      // At the APL itself the direction is arbitrary but fixed.
+      const glm::vec3 w = r > 0 ? d * (1.0f / r) : glm::vec3(0, 0, -1);
+      if (r < min_r) {
+        r2 = min_r * min_r;
+        ++result.clamped;
+      }
+      const float cosine = options.ignore_normal ? 1.0f : -glm::dot(n, w);
+      if (cosine <= 0.0f) continue;
+      const float v = visibility(i, a.position, x);
+      if (v <= 0.0f) continue;
+      footprints[count] = a.map.footprint(w);
+      for (const float* t : footprints[count].texel) __builtin_prefetch(t);
+      weights[count] = cosine * v / r2;
+      index[count] = i;
+      ++count;
     }
-    const float cosine = options.ignore_normal ? 1.0f : -glm::dot(n, w);
-    if (cosine <= 0.0f) continue;
-    const float v = visibility(i, a.position, x);
-    if (v <= 0.0f) continue;
-    sum += a.map.lookup(w) * (cosine * v / r2);
+    for (std::size_t k = 0; k < count; ++k) sum += level.apls[index[k]].map.blend(footprints[k]) * weights[k];
   }
   result.irradiance = glm::dvec3(sum);
   return result;

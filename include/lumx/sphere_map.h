@@ -58,30 +58,55 @@ inline glm::vec2 disk_to_square(float rho, float phi) {
   float a, b;
   if (phi < kQuarter) {  // right wedge: r = a, φ = π/4 · b/a
     a = rho;
-    b = phi / kQuarter * a;
+    b = phi * float(4 / kPi) * a;
   } else if (phi < 3 * kQuarter) {  // top wedge: r = b, φ = π/2 − π/4 · a/b
     b = rho;
-    a = (float(kPi / 2) - phi) / kQuarter * b;
+    a = (float(kPi / 2) - phi) * float(4 / kPi) * b;
   } else if (phi < 5 * kQuarter) {  // left wedge: r = a < 0, true angle φ = π + π/4 · b/a
     a = -rho;
-    b = (phi - float(kPi)) / kQuarter * a;
+    b = (phi - float(kPi)) * float(4 / kPi) * a;
   } else {  // bottom wedge: r = b < 0, true angle φ = 3π/2 − π/4 · a/b
     b = -rho;
-    a = (float(3 * kPi / 2) - phi) / kQuarter * b;
+    a = (float(3 * kPi / 2) - phi) * float(4 / kPi) * b;
   }
   return {std::clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), std::clamp(0.5f * (b + 1.0f), 0.0f, 1.0f)};
+}
+
+/// atan(t) for t ∈ [−1, 1]: an odd minimax polynomial t·P(t²) of degree 15, within 1.3e-7 rad in float
+/// (about one float ulp of π/4). glibc's atan2f costs ~35 ns here, most of a map lookup; this ~3 ns.
+inline float atan_unit(float t) {
+  const float u = t * t;
+  float p = -0.004054541713648427f;
+  p = p * u + 0.021862865288140798f;
+  p = p * u - 0.055912192615222414f;
+  p = p * u + 0.09642187457744139f;
+  p = p * u - 0.1390862567541859f;
+  p = p * u + 0.19946564874405892f;
+  p = p * u - 0.3332986071611589f;
+  p = p * u + 0.9999993355611796f;
+  return t * p;
 }
 
 /// Unit direction → hemisphere (0: z ≥ 0, the left square; 1: z < 0, the right square) and coordinates
 /// inside that hemisphere's square, [0,1]². Kept separate from direction_to_uv because u = 0.5 alone
 /// cannot tell the two squares' shared edge apart.
+///
+/// This is disk_to_square(ρ, atan2(y, x)) with the angle never formed: in each of the concentric map's
+/// four wedges the square coordinate along the wedge is ±ρ and the other is (4/π)·atan of the ratio
+/// of the in-plane components (y/x in the left/right wedges, x/y in the top/bottom ones) times it.
 inline glm::vec2 direction_to_square(const glm::vec3& w, int& half) {
   half = w.z < 0.0f ? 1 : 0;
   // Lambert: ρ² = 1 − |z| = (x² + y²) / (1 + |z|) for unit w; the second form keeps ρ's precision near
   // the poles, where 1 − |z| in float is quantised to multiples of 2⁻²⁴.
   const float rho = std::sqrt((w.x * w.x + w.y * w.y) / (1.0f + std::abs(w.z)));
-  const float phi = (w.x == 0.0f && w.y == 0.0f) ? 0.0f : std::atan2(w.y, w.x);
-  return disk_to_square(rho, phi);
+  // Written with selects rather than branches: the wedge of a random direction is unpredictable.
+  const bool x_major = std::abs(w.x) >= std::abs(w.y);
+  const float along = x_major ? w.x : w.y, across = x_major ? w.y : w.x;
+  const float ratio = along != 0.0f ? across / along : 0.0f;  // along = 0 only at a pole (ρ = 0)
+  const float major = std::copysign(rho, along);
+  const float minor = float(4 / kPi) * atan_unit(ratio) * major;
+  const float a = x_major ? major : minor, b = x_major ? minor : major;
+  return {std::clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), std::clamp(0.5f * (b + 1.0f), 0.0f, 1.0f)};
 }
 
 /// Unit direction → map coordinates (u, v) ∈ [0,1]², u across the 2R-wide image, v down its R rows.
@@ -174,20 +199,55 @@ class SphereMap {
 
   /// Bilinear value in direction w (unit), continuous across the equator seam, the squares' corners and
   /// the poles (see the header comment). A one-channel map returns its value in all three components.
-  glm::vec3 lookup(const glm::vec3& w) const {
+  glm::vec3 lookup(const glm::vec3& w) const { return blend(footprint(w)); }
+
+  /// The four texels and weights of a bilinear lookup, resolved before any texel is read. Splitting
+  /// lookup() into footprint() and blend() lets a caller evaluating many maps compute every footprint
+  /// first and prefetch its texels, so that cache misses to different maps overlap (apl_evaluation.h).
+  struct Footprint {
+    const float* texel[4];  ///< (x0,y0), (x0+1,y0), (x0,y0+1), (x0+1,y0+1), seam rule applied
+    float tx, ty;           ///< weights of the +1 texels
+  };
+
+  Footprint footprint(const glm::vec3& w) const {
     int half;
     const glm::vec2 s = sphere_map::direction_to_square(w, half);
     // Continuous texel coordinates inside the hemisphere's own square; centres at i + 0.5.
     const float px = s.x * float(resolution_) - 0.5f;
     const float py = s.y * float(resolution_) - 0.5f;
-    const float fx0 = std::floor(px), fy0 = std::floor(py);
-    const float tx = px - fx0, ty = py - fy0;
-    const int x0 = int(fx0), y0 = int(fy0);
-    const glm::vec3 v00 = fetch(half, x0, y0), v10 = fetch(half, x0 + 1, y0);
-    const glm::vec3 v01 = fetch(half, x0, y0 + 1), v11 = fetch(half, x0 + 1, y0 + 1);
-    // a + t·(b − a) returns a exactly when b == a, so a constant map looks up exactly constant.
-    const glm::vec3 row0 = v00 + tx * (v10 - v00), row1 = v01 + tx * (v11 - v01);
-    return row0 + ty * (row1 - row0);
+    // ⌊p⌋ for p ≥ −0.5 by truncation of p + 1 (std::floor is a library call without SSE4.1).
+    const int x0 = int(px + 1.0f) - 1, y0 = int(py + 1.0f) - 1;
+    Footprint f;
+    f.tx = px - float(x0);
+    f.ty = py - float(y0);
+    if (x0 >= 0 && y0 >= 0 && x0 + 1 < resolution_ && y0 + 1 < resolution_) {  // interior: no seam
+      const std::size_t row = std::size_t(width()) * channels_;
+      const float* p = values_.data() + (std::size_t(y0) * width() + std::size_t(half) * resolution_ + x0) * channels_;
+      f.texel[0] = p;
+      f.texel[1] = p + channels_;
+      f.texel[2] = p + row;
+      f.texel[3] = p + row + channels_;
+    } else {
+      f.texel[0] = fetch(half, x0, y0);
+      f.texel[1] = fetch(half, x0 + 1, y0);
+      f.texel[2] = fetch(half, x0, y0 + 1);
+      f.texel[3] = fetch(half, x0 + 1, y0 + 1);
+    }
+    return f;
+  }
+
+  /// The bilinear value of a footprint. a + t·(b − a) returns a exactly when b == a, so a constant map
+  /// looks up exactly constant.
+  glm::vec3 blend(const Footprint& f) const {
+    if (channels_ == 1) {
+      const float row0 = *f.texel[0] + f.tx * (*f.texel[1] - *f.texel[0]);
+      const float row1 = *f.texel[2] + f.tx * (*f.texel[3] - *f.texel[2]);
+      return glm::vec3(row0 + f.ty * (row1 - row0));
+    }
+    const glm::vec3 v00 = load3(f.texel[0]), v10 = load3(f.texel[1]);
+    const glm::vec3 v01 = load3(f.texel[2]), v11 = load3(f.texel[3]);
+    const glm::vec3 row0 = v00 + f.tx * (v10 - v00), row1 = v01 + f.tx * (v11 - v01);
+    return row0 + f.ty * (row1 - row0);
   }
 
   /// Adds `flux` (per channel, e.g. W or lm) arriving in direction w to the texel containing w, as
@@ -253,7 +313,7 @@ class SphereMap {
  private:
   /// Texel (lx, ly) of square `half`, where lx or ly may be −1 or R: outside a square's edge (or corner)
   /// lies the mirror texel of the other square (the equator seam rule).
-  glm::vec3 fetch(int half, int lx, int ly) const {
+  const float* fetch(int half, int lx, int ly) const {
     const int R = resolution_;
     // Each edge crossed flips to the other square; past a corner both edges are crossed, which flips
     // back (the texel diagonally past a corner is the square's own corner texel).
@@ -263,8 +323,9 @@ class SphereMap {
     if (ly < 0) ly = 0, ++flips;
     else if (ly >= R) ly = R - 1, ++flips;
     half ^= flips & 1;
-    return texel(half * R + lx, ly);
+    return values_.data() + (std::size_t(ly) * width() + std::size_t(half) * R + lx) * channels_;
   }
+  static glm::vec3 load3(const float* p) { return {p[0], p[1], p[2]}; }
 
   int resolution_ = 0;
   int channels_ = 0;
