@@ -52,6 +52,8 @@ SphereMap lobe_map(std::mt19937& rng, int R = kResolution) {
   return m;
 }
 
+/// The finest level holds 512 random lobes; each coarser level sums groups of children, so the levels
+/// are cuts of one tree (as a builder makes them) and the set passes check_apl_set.
 const AplSet& big_set() {
   static const AplSet set = [] {
     AplSet s;
@@ -59,18 +61,36 @@ const AplSet& big_set() {
     s.bounds.radius = 0.3;
     std::mt19937 rng(42);
     std::uniform_real_distribution<float> u(-0.3f, 0.3f);
-    for (int n : {1, 8, 64, 256, 512}) {
-      AplLevel level;
-      level.map_resolution = kResolution;
-      for (int i = 0; i < n; ++i) {
-        Apl a;
-        a.position = {u(rng), u(rng), u(rng)};
-        a.map = lobe_map(rng);
-        a.flux = a.map.integral();
-        level.apls.push_back(std::move(a));
-      }
-      s.levels.push_back(std::move(level));
+    const int counts[] = {1, 8, 64, 256, 512};
+    std::vector<AplLevel> levels(5);
+    levels[4].map_resolution = kResolution;
+    for (int i = 0; i < 512; ++i) {
+      Apl a;
+      a.position = {u(rng), u(rng), u(rng)};
+      a.parent = i / 2;
+      a.map = lobe_map(rng);
+      levels[4].apls.push_back(std::move(a));
     }
+    for (int k = 3; k >= 0; --k) {
+      const int n = counts[k], group = counts[k + 1] / n;
+      levels[std::size_t(k)].map_resolution = kResolution;
+      for (int p = 0; p < n; ++p) {
+        Apl a;
+        a.parent = k == 0 ? -1 : p / (n / counts[k - 1]);
+        a.map = SphereMap(kResolution, 3);
+        ::madvise(a.map.data(), a.map.bytes(), MADV_HUGEPAGE);
+        glm::vec3 centre(0.0f);
+        for (int c = p * group; c < (p + 1) * group; ++c) {
+          const Apl& child = levels[std::size_t(k + 1)].apls[std::size_t(c)];
+          for (std::size_t t = 0; t < a.map.values().size(); ++t) a.map.values()[t] += child.map.values()[t];
+          centre += child.position;
+        }
+        a.position = centre / float(group);
+        levels[std::size_t(k)].apls.push_back(std::move(a));
+      }
+    }
+    s.levels = std::move(levels);
+    update_fluxes(s);
     return s;
   }();
   return set;
@@ -84,15 +104,21 @@ std::vector<glm::vec3> random_directions(std::size_t n, unsigned seed) {
   return d;
 }
 
+/// Times `query(direction)` over 4096 random directions, cycled.
+template <class Query>
+void over_random_directions(benchmark::State& state, unsigned seed, Query query) {
+  const auto dirs = random_directions(4096, seed);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(query(dirs[i]));
+    i = (i + 1) & 4095;
+  }
+}
+
 void intensity(benchmark::State& state) {
   std::mt19937 rng(1);
   const SphereMap map = lobe_map(rng);
-  const auto dirs = random_directions(4096, 2);
-  std::size_t i = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(map.lookup(dirs[i]));
-    i = (i + 1) & 4095;
-  }
+  over_random_directions(state, 2, [&](const glm::vec3& w) { return map.lookup(w); });
 }
 BENCHMARK(intensity);
 
@@ -164,12 +190,7 @@ void pdf(benchmark::State& state) {
   std::mt19937 rng(5);
   const SphereMap map = lobe_map(rng);
   const SphereMapSampler sampler(map);
-  const auto dirs = random_directions(4096, 6);
-  std::size_t i = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(sampler.pdf(dirs[i]));
-    i = (i + 1) & 4095;
-  }
+  over_random_directions(state, 6, [&](const glm::vec3& w) { return sampler.pdf(w); });
 }
 BENCHMARK(pdf);
 
