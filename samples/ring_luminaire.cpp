@@ -181,7 +181,9 @@ int main(int argc, char** argv) {
     write_photometry(far, out + ".ies");
     std::printf("\nfar field: %s.ies (flux %.2f lm; the LEDs emit %.2f lm)\n", out.c_str(),
                 IntensityTable(far).flux_lm(), kLeds * kLedFlux);
-    std::printf("radiance volume: %d x %d x %d voxels of %.4f m; glow at the ring looking down: %.1f cd/m^2\n",
+    // Directions are those the light travels: (0, 0, -1) is the light heading down, which a viewer
+    // below the ring looking up sees.
+    std::printf("radiance volume: %d x %d x %d voxels of %.4f m; glow seen from below the ring: %.1f cd/m^2\n",
                 volume.counts().x, volume.counts().y, volume.counts().z, volume.voxel_size(),
                 volume.radiance({kRing, 0.0, -0.01}, {0, 0, -1}).x);
   } catch (const std::exception& e) {

@@ -348,7 +348,120 @@ TEST(Bundle, InconsistentOrHostileManifestsAreRejected) {
   fs::copy_file(s / file, root / "outside.exr");
   fs::remove(s / file);
   fs::create_symlink(root / "outside.exr", s / file);
-  EXPECT_NE(load_error(s).find("outside the bundle"), std::string::npos);
+  EXPECT_NE(load_error(s).find("symbolic link"), std::string::npos);
+  // Numbers beyond double's range, members the format does not define, a wrong radiance unit.
+  const fs::path big = root / "big.lumx";
+  fs::copy(good, big, fs::copy_options::recursive);
+  std::string t = slurp(big / "manifest.json");
+  t.replace(t.find("\"radius\": ") + 10, 1, "1e400,");
+  spit(big / "manifest.json", t);
+  EXPECT_NE(load_error(big).find("manifest.json"), std::string::npos);
+  expect([](auto& j) { j["levels"][0]["surprise"] = 1; }, "/levels/0/surprise");
+  expect([](auto& j) { j["units"]["colour"] = "red"; }, "/units/colour");
+}
+
+TEST(Bundle, VolumeManifestRulesAreEnforced) {
+  const fs::path root = scratch("volume_manifest");
+  const fs::path good = root / "good.lumx";
+  RadianceVolume volume(Aabb{glm::dvec3(-0.1), glm::dvec3(0.1)}, 64, 2, 1);
+  write_bundle(good.string(), three_level_set(8, ChannelLayout::luminance), &volume);
+  const nlohmann::json m = read_manifest(good);
+  int n = 0;
+  auto expect = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& needle) {
+    const fs::path b = root / ("case" + std::to_string(n++) + ".lumx");
+    fs::copy(good, b, fs::copy_options::recursive);
+    nlohmann::json j = m;
+    edit(j);
+    write_manifest(b, j);
+    const std::string e = load_error(b);
+    EXPECT_NE(e.find(needle), std::string::npos) << "expected \"" << needle << "\" in: " << e;
+  };
+  expect([](auto& j) { j["volume"]["counts"] = {2, 4096, 4096}; }, "/volume/counts");  // > 2^24 voxels
+  expect([](auto& j) { j["volume"]["radiance_unit"] = "W/(m^2 sr)"; }, "/volume/radiance_unit");
+  expect([](auto& j) { j["volume"].erase("window"); }, "/volume/window");
+  expect([](auto& j) { j["volume"]["voxel_size"] = 1.0; }, "/volume/bounds");
+}
+
+TEST(Bundle, WriterRefusesSetsItsReaderWouldReject) {
+  const fs::path dir = scratch("refuse") / "r.lumx";
+  AplSet set = three_level_set(8, ChannelLayout::luminance);
+  {
+    AplSet s = set;
+    s.levels[1].apls[0].flux = glm::dvec3(NAN);
+    EXPECT_THROW(write_bundle(dir.string(), s), Error);
+  }
+  {
+    AplSet s = set;
+    s.bounds.center.x = INFINITY;
+    EXPECT_THROW(write_bundle(dir.string(), s), Error);
+  }
+  {
+    AplSet s = set;
+    s.levels[2].error.relative_distance = {0.0, 1.0};  // d must be > 0
+    s.levels[2].error.relative_rmse = {0.1, 0.05};
+    EXPECT_THROW(write_bundle(dir.string(), s), Error);
+  }
+  EXPECT_FALSE(fs::exists(dir));
+}
+
+TEST(Bundle, HalfIsNotUsedWhenItsRoundingWouldChangeTheFlux) {
+  // One texel at 1.0 and all others at 8.5·2^-24, deep in half's subnormal range: half would round
+  // the background down by ~6 % and the flux by ~0.4 %.
+  AplSet set;
+  AplLevel level;
+  level.map_resolution = 64;
+  Apl a;
+  a.map = SphereMap(64, 1);
+  std::fill(a.map.values().begin(), a.map.values().end(), 8.5f * std::ldexp(1.0f, -24));
+  a.map.at(3, 3, 0) = 1.0f;
+  a.flux = a.map.integral();
+  level.apls.push_back(a);
+  set.levels.push_back(level);
+  const fs::path dir = scratch("subnormal") / "s.lumx";
+  write_bundle(dir.string(), set);
+  BundleReader r(dir.string());
+  EXPECT_EQ(r.manifest().levels[0].maps[0].pixel_type, "float");
+  EXPECT_NO_THROW(r.load());
+}
+
+TEST(Bundle, SkippedLevelsKeepAValidTree) {
+  const AplSet set = three_level_set(8, ChannelLayout::luminance);
+  const fs::path dir = scratch("skip") / "k.lumx";
+  write_bundle(dir.string(), set);
+  const AplSet partial = BundleReader(dir.string()).load({0, 2});
+  ASSERT_EQ(partial.levels.size(), 2u);
+  EXPECT_TRUE(check_apl_set(partial).empty());
+  for (std::size_t i = 0; i < 64; ++i) EXPECT_EQ(partial.levels[1].apls[i].parent, 0);  // the root's grandchildren
+  // A limit on what one load may decode is enforced before reading.
+  BundleLimits tiny;
+  tiny.max_loaded_bytes = 1000;
+  EXPECT_THROW(BundleReader(dir.string(), tiny).load(), Error);
+}
+
+TEST(Bundle, WriterOnlyReplacesLumxBundlesAndFollowsLinks) {
+  const fs::path root = scratch("targets");
+  const AplSet set = three_level_set(8, ChannelLayout::luminance);
+  // A folder with a manifest.json that is not a lumx manifest (a web app, say) is never replaced.
+  const fs::path app = root / "myapp";
+  fs::create_directories(app);
+  spit(app / "manifest.json", "{\"name\": \"my app\"}");
+  spit(app / "index.html", "<html></html>");
+  EXPECT_THROW(write_bundle(app.string(), set), Error);
+  EXPECT_EQ(slurp(app / "index.html"), "<html></html>");
+  // A bundle someone added a file to is not replaced either.
+  const fs::path bundle = root / "lamp.lumx";
+  write_bundle(bundle.string(), set);
+  spit(bundle / "notes.txt", "mine");
+  EXPECT_THROW(write_bundle(bundle.string(), set), Error);
+  fs::remove(bundle / "notes.txt");
+  // A trailing separator names the same folder.
+  EXPECT_NO_THROW(write_bundle(bundle.string() + "/", set));
+  // A symbolic link to a bundle: the bundle it points to is replaced and the link is kept.
+  const fs::path link = root / "current.lumx";
+  fs::create_directory_symlink(bundle, link);
+  write_bundle(link.string(), three_level_set(16, ChannelLayout::luminance));
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(BundleReader(bundle.string()).manifest().levels[0].map_resolution, 16);
 }
 
 TEST(Bundle, WriterOutputValidatesAgainstTheJsonSchema) {

@@ -56,7 +56,7 @@ inline double interpolated_error(const ErrorTable& table, double d) {
   const auto& ds = table.relative_distance;
   const auto& es = table.relative_rmse;
   if (ds.empty() || es.size() != ds.size()) return INFINITY;
-  if (d <= ds.front()) return es.front();
+  if (!(d > ds.front())) return es.front();  // also NaN: never index past the table
   if (d >= ds.back()) return es.back();
   const std::size_t j = std::size_t(std::upper_bound(ds.begin(), ds.end(), d) - ds.begin());
   const double t = (std::log(d) - std::log(ds[j - 1])) / (std::log(ds[j]) - std::log(ds[j - 1]));

@@ -3,8 +3,10 @@
 // Two samplers, each with a pdf function that returns exactly what sampling returned, so estimators
 // that combine strategies (multiple importance sampling, Veach 1997 ch. 9) weight them correctly:
 //  - Emission (light tracing, photon mapping, BDPT): pick an APL with probability ∝ its flux, then a
-//    direction from its map (piecewise-constant on the equal-area map: pdf_ω = pdf_uv / 4π;
-//    algorithms.md §3). The emitted flux of the sample is I(ω) / (p_apl · pdf_ω).
+//    direction, piecewise-constant over the equal-area map's texels (pdf_ω = pdf_uv / 4π; algorithms.md
+//    §3) in proportion to the map dilated by one texel (SphereMap::dilated). The sample's flux is the
+//    bilinear I(ω) — the same intensity every other query uses — over p_apl · pdf_ω; the dilation makes
+//    pdf_ω > 0 wherever I(ω) > 0, so the estimator is unbiased.
 //  - Light selection at a shading point (next-event estimation): pick one APL with probability ∝ an
 //    estimate of its contribution, Φ_i · max(0, cos θ_i) / r_i², where Φ_i is its flux (as if it were
 //    isotropic) and θ_i the angle at the receiver. Every APL that can contribute (cos θ > 0) has a
@@ -34,14 +36,14 @@ struct EmissionSample {
   bool valid() const { return pdf_apl > 0 && pdf_direction > 0; }
 };
 
-/// Emission sampling of one level. Holds one SphereMapSampler per APL (about the size of the maps).
+/// Emission sampling of one level. Holds one SphereMapSampler per APL (4 bytes per texel).
 class AplEmissionSampler {
  public:
   AplEmissionSampler(const AplSet& set, std::size_t level_index) : level_(&set.levels.at(level_index)) {
     std::vector<float> power;
     for (const Apl& a : level_->apls) {
       power.push_back(float(std::max(0.0, luminance_of(set.channels, a.flux))));
-      samplers_.emplace_back(a.map);
+      samplers_.emplace_back(a.map.dilated());
     }
     choose_ = PiecewiseConstant1D(power.data(), power.size());
   }
@@ -60,7 +62,7 @@ class AplEmissionSampler {
     const DirectionSample d = samplers_[s.apl].sample(u1, u2);
     s.direction = d.direction;
     s.pdf_direction = d.pdf;
-    if (s.valid()) s.flux = a.map.lookup_nearest(s.direction) / (s.pdf_apl * s.pdf_direction);
+    if (s.valid()) s.flux = a.map.lookup(s.direction) / (s.pdf_apl * s.pdf_direction);
     return s;
   }
 

@@ -131,7 +131,8 @@ inline BoundingSphere bounding_sphere_of(const AplSet& set) {
 /// Consistency rules of a set; each violation is one message naming the level, APL and field.
 ///   - at least one level; levels strictly increasing in APL count; no empty level;
 ///   - every map has the level's resolution and the set's channel count; values finite and ≥ 0;
-///   - positions finite; parent indices valid (−1 in level 0, in range afterwards);
+///   - positions, the bounding sphere and fluxes finite, fluxes ≥ 0; error tables well formed;
+///   - parent indices valid (−1 in level 0, in range afterwards);
 ///   - each APL's flux equals its map's integral within `flux_tolerance` relative (plus 1e-6 of the level's
 ///     flux, for APLs with next to no flux);
 ///   - each parent's flux equals the sum of its children's, with the same tolerance (cuts of one tree).
@@ -141,6 +142,8 @@ inline std::vector<std::string> check_apl_set(const AplSet& set, double flux_tol
   if (set.levels.empty()) out.push_back("levels: the set has no level");
   if (!(set.bounds.radius >= 0) || !std::isfinite(set.bounds.radius))
     out.push_back("bounding_sphere.radius: not a finite non-negative number");
+  if (!std::isfinite(set.bounds.center.x) || !std::isfinite(set.bounds.center.y) || !std::isfinite(set.bounds.center.z))
+    out.push_back("bounding_sphere.center: not finite");
   for (std::size_t k = 0; k < set.levels.size(); ++k) {
     const AplLevel& level = set.levels[k];
     const std::string where = "levels[" + std::to_string(k) + "]";
@@ -148,6 +151,15 @@ inline std::vector<std::string> check_apl_set(const AplSet& set, double flux_tol
     if (k > 0 && level.apls.size() <= set.levels[k - 1].apls.size())
       out.push_back(where + ": APL count " + std::to_string(level.apls.size()) +
                     " does not exceed the previous level's");
+    const ErrorTable& e = level.error;
+    bool table_ok = e.relative_rmse.size() == e.relative_distance.size() && e.relative_distance.size() <= 4096;
+    for (std::size_t j = 0; table_ok && j < e.relative_distance.size(); ++j)
+      table_ok = e.relative_distance[j] > 0 && std::isfinite(e.relative_distance[j]) &&
+                 (j == 0 || e.relative_distance[j] > e.relative_distance[j - 1]) && e.relative_rmse[j] >= 0 &&
+                 std::isfinite(e.relative_rmse[j]);
+    if (!table_ok)
+      out.push_back(where + ".error: distances must be positive, finite and increasing, errors finite and ≥ 0, "
+                            "one error per distance (at most 4096)");
     const double level_flux = luminance_of(set.channels, level.flux());
     const double floor_tol = 1e-6 * std::abs(level_flux);
     auto tol = [&](const glm::dvec3& f) { return flux_tolerance * std::abs(luminance_of(set.channels, f)) + floor_tol; };
@@ -156,6 +168,11 @@ inline std::vector<std::string> check_apl_set(const AplSet& set, double flux_tol
       const std::string at = where + ".apls[" + std::to_string(i) + "]";
       if (!std::isfinite(a.position.x) || !std::isfinite(a.position.y) || !std::isfinite(a.position.z))
         out.push_back(at + ".position: not finite");
+      for (int c = 0; c < nc; ++c)
+        if (!(a.flux[c] >= 0) || !std::isfinite(a.flux[c])) {
+          out.push_back(at + ".flux: channel " + std::to_string(c) + " is negative or not finite");
+          break;
+        }
       if (a.map.resolution() != level.map_resolution || a.map.channels() != nc) {
         out.push_back(at + ".map: resolution " + std::to_string(a.map.resolution()) + " × " +
                       std::to_string(a.map.channels()) + " channels, expected " +
@@ -166,7 +183,7 @@ inline std::vector<std::string> check_apl_set(const AplSet& set, double flux_tol
       if (!a.map.all_finite_nonnegative(&bx, &by, &bc))
         out.push_back(at + ".map: texel (" + std::to_string(bx) + ", " + std::to_string(by) + ") channel " +
                       std::to_string(bc) + " is negative or not finite");
-      else if (std::abs(luminance_of(set.channels, a.map.integral() - a.flux)) > tol(a.flux))
+      else if (!(std::abs(luminance_of(set.channels, a.map.integral() - a.flux)) <= tol(a.flux)))
         out.push_back(at + ".flux: differs from the integral of its map");
       if (k == 0 ? a.parent != -1 : (a.parent < 0 || std::size_t(a.parent) >= set.levels[k - 1].apls.size()))
         out.push_back(at + ".parent: " + std::to_string(a.parent) + " is not a valid index");
@@ -176,8 +193,8 @@ inline std::vector<std::string> check_apl_set(const AplSet& set, double flux_tol
     for (const Apl& a : level.apls)
       if (a.parent >= 0 && std::size_t(a.parent) < child_sum.size()) child_sum[a.parent] += a.flux;
     for (std::size_t p = 0; p < child_sum.size(); ++p)
-      if (std::abs(luminance_of(set.channels, child_sum[p] - set.levels[k - 1].apls[p].flux)) >
-          tol(set.levels[k - 1].apls[p].flux))
+      if (!(std::abs(luminance_of(set.channels, child_sum[p] - set.levels[k - 1].apls[p].flux)) <=
+            tol(set.levels[k - 1].apls[p].flux)))
         out.push_back(where + ": children of levels[" + std::to_string(k - 1) + "].apls[" + std::to_string(p) +
                       "] do not sum to its flux");
   }

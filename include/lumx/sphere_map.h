@@ -294,6 +294,25 @@ class SphereMap {
     return true;
   }
 
+  /// Each texel replaced by the maximum over its 3×3 neighbourhood (seam rule applied), per channel.
+  /// Every texel a bilinear lookup inside texel T reads lies in T's neighbourhood, so a sampler built on
+  /// this map gives a non-zero pdf wherever lookup() is non-zero (apl_sampling.h).
+  SphereMap dilated() const {
+    SphereMap out(resolution_, channels_);
+    const int R = resolution_;
+    for (int half = 0; half < 2; ++half)
+      for (int ly = 0; ly < R; ++ly)
+        for (int lx = 0; lx < R; ++lx) {
+          float* o = &out.at(half * R + lx, ly, 0);
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const float* t = fetch(half, lx + dx, ly + dy);
+              for (int c = 0; c < channels_; ++c) o[c] = std::max(o[c], t[c]);
+            }
+        }
+    return out;
+  }
+
   /// The map at half the resolution: each texel is the mean of a 2×2 block. Blocks never straddle the
   /// two squares and all texels have equal solid angle, so integral() is unchanged (up to rounding).
   /// Requires an even resolution.

@@ -12,9 +12,8 @@
 // that the direction it returns falls in, found by the same rule pdf() and lookup_nearest() use. That
 // is also the density of the texel it was drawn from: in exact arithmetic the two texels differ only
 // for points on texel edges, a set of measure zero. In float they differ when rounding in the map's
-// transforms moves a point lying within ~1e-7 of an edge across it (and, with sphere_map.h's
-// ρ = √(1 − |z|), points within ~1e-4 of a pole at large R: 13–19 % of the four pole texels at
-// R = 4096). Such points are pulled towards their texel's centre and lifted again, so a sample lies in
+// transforms moves a point lying within ~1e-7 of an edge across it (a first version of sphere_map.h,
+// with ρ = √(1 − |z|), also moved points within ~1e-4 of a pole at large R). Such points are pulled towards their texel's centre and lifted again, so a sample lies in
 // the texel it was drawn from (and never in a zero texel); its pdf is still computed from the returned
 // direction, so the equality holds even if the pull were to fail.
 #pragma once

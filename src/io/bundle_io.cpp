@@ -9,7 +9,11 @@
 #include "io/exr_image.h"
 #include "io/sha256.h"
 
+#include <nlohmann/json.hpp>
+#include <half.h>
+
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <stdio.h>
 #include <unistd.h>
 
@@ -60,6 +64,20 @@ bool choose_half(float max_value, MapPixelType type, const std::string& what) {
   return false;
 }
 
+/// True when rounding every map to half changes no map's integral by more than 1e-4 (relative): values
+/// in half's subnormal range can lose several per cent each, which would break the manifest's flux.
+bool half_keeps_flux(const std::vector<const SphereMap*>& maps) {
+  for (const SphereMap* m : maps) {
+    double exact = 0, rounded = 0;
+    for (float v : m->values()) {
+      exact += double(v);
+      rounded += double(float(Imath::half(v)));
+    }
+    if (std::abs(rounded - exact) > 1e-4 * std::abs(exact)) return false;
+  }
+  return true;
+}
+
 BundlePayload write_payload(const std::string& folder, const std::string& relative, const detail::ExrImage& image) {
   BundlePayload p;
   p.file = relative;
@@ -85,6 +103,62 @@ std::string temporary_sibling(const fs::path& target) {
       .string();
 }
 
+/// The folder to write: absolute, normalised, without a trailing separator; a symbolic link is followed
+/// so that the bundle it points to is replaced and the link keeps pointing at it.
+fs::path resolve_target(const std::string& path) {
+  fs::path target = fs::absolute(fs::path(path)).lexically_normal();
+  if (target.filename().empty()) target = target.parent_path();  // "lamp.lumx/" names lamp.lumx
+  if (target.filename().empty() || target == target.root_path()) fail(path, "path", "names no folder");
+  std::error_code ec;
+  if (fs::is_symlink(target, ec)) target = fs::canonical(target);
+  return target;
+}
+
+/// Refuses to replace anything but a lumx bundle: a folder whose manifest says "format": "lumx-bundle"
+/// and that holds nothing but what a bundle holds (so a user's folder is never swapped out and deleted).
+void require_replaceable_bundle(const fs::path& target, const std::string& path) {
+  const std::string refuse = "exists and is not a lumx bundle; refusing to replace it";
+  std::error_code ec;
+  if (!fs::is_directory(target, ec)) fail(path, "path", refuse);
+  bool is_bundle = false;
+  try {
+    const std::string text = read_file_bounded((target / bundle::kManifestName).string(), 64u << 20);
+    const nlohmann::json j = nlohmann::json::parse(text);
+    is_bundle = j.is_object() && j.value("format", "") == bundle::kFormatName;
+  } catch (const std::exception&) {
+    is_bundle = false;
+  }
+  if (!is_bundle) fail(path, "path", refuse + " (no lumx manifest.json)");
+  for (const auto& e : fs::directory_iterator(target)) {
+    const std::string name = e.path().filename().string();
+    const bool expected = (name == bundle::kManifestName && e.is_regular_file()) ||
+                          (name == "volume.exr" && e.is_regular_file()) || (name == "levels" && e.is_directory());
+    if (!expected) fail(path, "path", refuse + " (it holds \"" + name + "\")");
+  }
+  if (fs::is_directory(target / "levels"))
+    for (const auto& e : fs::directory_iterator(target / "levels"))
+      if (!e.is_regular_file() || e.path().extension() != ".exr")
+        fail(path, "path", refuse + " (levels/ holds \"" + e.path().filename().string() + "\")");
+}
+
+/// Replaces `target` (an existing bundle) by `fresh`: one atomic swap where the file system supports
+/// renameat2(RENAME_EXCHANGE); otherwise the old bundle is first renamed aside, which leaves a short
+/// window in which `target` does not exist. Either way the old bundle ends up at `fresh` and is deleted.
+void swap_in(const std::string& fresh, const fs::path& target, const std::string& path) {
+  if (::renameat2(AT_FDCWD, fresh.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) return;
+  if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP)
+    fail(path, "rename", std::string("cannot swap in the new bundle: ") + std::strerror(errno));
+  const std::string aside = temporary_sibling(target);
+  if (::rename(target.c_str(), aside.c_str()) != 0)
+    fail(path, "rename", std::string("cannot move the old bundle aside: ") + std::strerror(errno));
+  if (::rename(fresh.c_str(), target.c_str()) != 0) {
+    const int err = errno;
+    ::rename(aside.c_str(), target.c_str());  // put the old one back
+    fail(path, "rename", std::string("cannot move the new bundle in place: ") + std::strerror(err));
+  }
+  if (::rename(aside.c_str(), fresh.c_str()) != 0) fs::remove_all(aside);
+}
+
 }  // namespace
 
 std::uint64_t BundleManifest::total_bytes() const {
@@ -101,12 +175,10 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
                   const BundleWriteOptions& options) {
   if (const auto problems = check_apl_set(set); !problems.empty())
     fail(path, "APL set", problems.front() + (problems.size() > 1 ? " (and " + std::to_string(problems.size() - 1) + " more)" : ""));
-  const fs::path target = fs::absolute(fs::path(path)).lexically_normal();
-  if (target.filename().empty()) fail(path, "path", "names no folder");
+  const fs::path target = resolve_target(path);
   std::error_code ec;
   const bool exists = fs::exists(target, ec);
-  if (exists && (!fs::is_directory(target) || !fs::exists(target / bundle::kManifestName)))
-    fail(path, "path", "exists and is not a lumx bundle; refusing to replace it");
+  if (exists) require_replaceable_bundle(target, path);
 
   const std::string tmp = temporary_sibling(target);
   try {
@@ -140,6 +212,7 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
         char name[64];
         std::snprintf(name, sizeof name, "levels/level%02zu_n%05zu_r%04d.exr", k, level.apls.size(), R);
         image.half = choose_half(max_value, options.pixel_type, path + "/" + name);
+        if (image.half && options.pixel_type == MapPixelType::automatic && !half_keeps_flux(maps)) image.half = false;
         BundlePayload p = write_payload(tmp, name, image);
         p.resolution = R;
         info.maps.push_back(p);
@@ -171,14 +244,15 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
       v.payload = write_payload(tmp, "volume.exr", image);
       m.volume = v;
     }
-    write_file_atomically(join(tmp, bundle::kManifestName), detail::manifest_to_json(m));
+    // The writer's output must be what its reader accepts: parse it back before anything is replaced.
+    const std::string manifest_text = detail::manifest_to_json(m);
+    detail::parse_manifest(manifest_text, path + "/" + bundle::kManifestName, BundleLimits{});
+    write_file_atomically(join(tmp, bundle::kManifestName), manifest_text);
     fsync_folder(tmp + "/levels");
     fsync_folder(tmp);
 
     if (exists) {
-      // Swap the complete new folder with the old one in one step, then delete the old one.
-      if (::renameat2(AT_FDCWD, tmp.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0)
-        fail(path, "rename", std::string("cannot swap in the new bundle: ") + std::strerror(errno));
+      swap_in(tmp, target, path);  // the old bundle is now at tmp
       fs::remove_all(tmp, ec);
     } else if (::rename(tmp.c_str(), target.c_str()) != 0) {
       fail(path, "rename", std::string("cannot move the new bundle in place: ") + std::strerror(errno));
@@ -195,32 +269,90 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
 
 // ---------------------------------------------------------------------------------------------- reading
 
+namespace {
+
+/// Reads a whole file opened with `fd` (closed on return), refusing anything but a regular file of
+/// exactly `expected` bytes (or at most `limit` bytes when expected is 0).
+std::string read_fd(int fd, const std::string& file, const std::string& field, std::uint64_t expected,
+                    std::uint64_t limit) {
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) fail(file, field, "not a regular file");
+  const std::uint64_t size = std::uint64_t(st.st_size);
+  if (expected > 0 && size != expected)
+    fail(file, field + "/bytes", "file has " + std::to_string(size) + " bytes, the manifest says " + std::to_string(expected));
+  if (expected == 0 && size > limit)
+    fail(file, field, "file has " + std::to_string(size) + " bytes, more than the limit " + std::to_string(limit));
+  std::string bytes(std::size_t(size), '\0');
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, &bytes[done], bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) fail(file, field, "file changed or could not be read while reading");
+    done += std::size_t(n);
+  }
+  return bytes;
+}
+
+/// Opens `relative` ('/'-separated) below the folder `dir_fd` without following symbolic links in any
+/// component, so a payload cannot lead outside the bundle however the folder changes meanwhile.
+int open_inside(int dir_fd, const std::string& relative, const std::string& file, const std::string& field) {
+  int current = dir_fd;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t slash = relative.find('/', start);
+    const std::string part = relative.substr(start, slash == std::string::npos ? std::string::npos : slash - start);
+    const bool last = slash == std::string::npos;
+    const int flags = O_RDONLY | O_CLOEXEC | O_NOFOLLOW | (last ? 0 : O_DIRECTORY);
+    const int fd = part.empty() || part == "." || part == ".." ? (errno = EINVAL, -1) : ::openat(current, part.c_str(), flags);
+    const int err = errno;
+    if (current != dir_fd) ::close(current);
+    if (fd < 0) {
+      if (err == ENOENT) fail(file, field, "payload missing");
+      if (err == ELOOP || err == ENOTDIR) fail(file, field, "is or passes through a symbolic link (payloads must be files inside the bundle)");
+      fail(file, field, std::string("cannot open: ") + std::strerror(err));
+    }
+    if (last) return fd;
+    current = fd;
+    start = slash + 1;
+  }
+}
+
+}  // namespace
+
 BundleReader::BundleReader(const std::string& path, const BundleLimits& limits) : path_(path), limits_(limits) {
   const std::string manifest_path = join(path, bundle::kManifestName);
-  std::error_code ec;
-  if (!fs::is_directory(path, ec)) fail(path, "bundle", "is not a folder");
-  if (!fs::is_regular_file(manifest_path, ec)) fail(manifest_path, "manifest", "missing");
-  const std::string text = read_file_bounded(manifest_path, std::size_t(limits.max_manifest_bytes));
+  folder_fd_ = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (folder_fd_ < 0) fail(path, "bundle", errno == ENOENT ? "does not exist" : "is not a folder");
+  const int fd = open_inside(folder_fd_, bundle::kManifestName, manifest_path, "manifest");
+  const std::string text = read_fd(fd, manifest_path, "manifest", 0, limits.max_manifest_bytes);
   bytes_read_ += text.size();
   manifest_ = detail::parse_manifest(text, manifest_path, limits);
 }
 
+BundleReader::~BundleReader() {
+  if (folder_fd_ >= 0) ::close(folder_fd_);
+}
+
+BundleReader::BundleReader(BundleReader&& other) noexcept
+    : path_(std::move(other.path_)),
+      limits_(other.limits_),
+      manifest_(std::move(other.manifest_)),
+      bytes_read_(other.bytes_read_),
+      folder_fd_(other.folder_fd_) {
+  other.folder_fd_ = -1;
+}
+
 std::string BundleReader::read_payload(const BundlePayload& p, const std::string& field) const {
   const std::string file = join(path_, p.file);
-  std::error_code ec;
-  // The payload must be a regular file inside the bundle even after resolving symbolic links.
-  const fs::path real = fs::weakly_canonical(file, ec);
-  const fs::path root = fs::weakly_canonical(path_, ec);
-  const std::string rel = real.lexically_relative(root).string();
-  if (ec || rel.empty() || rel.rfind("..", 0) == 0) fail(file, field + "/file", "resolves outside the bundle");
-  if (!fs::is_regular_file(real, ec)) fail(file, field + "/file", "payload missing");
-  const std::uint64_t size = fs::file_size(real, ec);
-  if (ec || size != p.bytes)
-    fail(file, field + "/bytes", "file has " + std::to_string(size) + " bytes, the manifest says " + std::to_string(p.bytes));
-  std::string bytes = read_file_bounded(real.string(), std::size_t(p.bytes));
+  const int fd = open_inside(folder_fd_, p.file, file, field + "/file");
+  std::string bytes = read_fd(fd, file, field, p.bytes, p.bytes);
   bytes_read_ += bytes.size();
-  if (bytes.size() != p.bytes) fail(file, field + "/bytes", "file changed while being read");
-  if (detail::sha256_hex(bytes) != p.sha256) fail(file, field + "/sha256", "checksum mismatch: the payload is corrupted");
+  if (detail::sha256_hex(bytes) != p.sha256)
+    fail(file, field + "/sha256", "checksum mismatch: the payload is corrupted (or was replaced after the manifest was read)");
   return bytes;
 }
 
@@ -252,8 +384,8 @@ AplLevel BundleReader::load_level(std::size_t k, int max_resolution) const {
   const int R = payload.resolution;
   const std::size_t n = info.apl_count();
   const auto names = detail::map_channel_names(manifest_.channels);
-  detail::ExrImage image = detail::decode_exr(bytes, file, 2 * R, R * int(n), names);
-  if (image.half != (payload.pixel_type == "half"))
+  detail::ExrReader image(bytes, file, 2 * R, R * int(n), names);
+  if (image.half() != (payload.pixel_type == "half"))
     fail(file, field + "/pixel_type", "the manifest says " + payload.pixel_type + ", the image disagrees");
 
   AplLevel level;
@@ -261,7 +393,6 @@ AplLevel BundleReader::load_level(std::size_t k, int max_resolution) const {
   level.error = info.error;
   level.apls.resize(n);
   const int nc = channel_count(manifest_.channels);
-  const std::size_t per_map = std::size_t(2) * R * R * nc;
   double level_flux = 0;
   for (const glm::dvec3& f : info.flux) level_flux += luminance_of(manifest_.channels, f);
   for (std::size_t i = 0; i < n; ++i) {
@@ -270,8 +401,7 @@ AplLevel BundleReader::load_level(std::size_t k, int max_resolution) const {
     a.flux = info.flux[i];
     a.parent = info.parent[i];
     a.map = SphereMap(R, nc);
-    std::copy(image.pixels.begin() + std::ptrdiff_t(i * per_map), image.pixels.begin() + std::ptrdiff_t((i + 1) * per_map),
-              a.map.values().begin());
+    image.read_rows(int(i) * R, int(i + 1) * R - 1, a.map.data());  // each map decodes into its own storage
     int bx = 0, by = 0, bc = 0;
     if (!a.map.all_finite_nonnegative(&bx, &by, &bc))
       fail(file, "APL " + std::to_string(i) + " texel (" + std::to_string(bx) + ", " + std::to_string(by) + ")",
@@ -295,14 +425,30 @@ AplSet BundleReader::load(const std::vector<std::size_t>& levels, int max_resolu
   std::vector<std::size_t> chosen = levels;
   if (chosen.empty())
     for (std::size_t k = 0; k < manifest_.levels.size(); ++k) chosen.push_back(k);
+  std::uint64_t decoded = 0;
+  for (std::size_t k : chosen) {
+    if (k >= manifest_.levels.size()) break;  // load_level reports it
+    const BundleLevelInfo& l = manifest_.levels[k];
+    decoded += std::uint64_t(l.apl_count()) * 2 * std::uint64_t(l.map_resolution) * std::uint64_t(l.map_resolution) *
+               std::uint64_t(channel_count(manifest_.channels)) * sizeof(float);
+  }
+  if (max_resolution <= 0 && decoded > limits_.max_loaded_bytes)
+    fail(path_, "levels", "loading them would take " + std::to_string(decoded) + " bytes, above BundleLimits::max_loaded_bytes");
   AplSet set = empty_set();
   std::size_t previous = std::size_t(-1);
   for (std::size_t k : chosen) {
     if (previous != std::size_t(-1) && k <= previous) fail(path_, "levels", "requested levels must increase");
     AplLevel level = load_level(k, max_resolution);
-    // Parent links name the manifest's previous level; keep them only if that level is loaded just before.
-    if (set.levels.empty() || previous + 1 != k)
-      for (Apl& a : level.apls) a.parent = -1;
+    // Parent links name the manifest's previous level. When levels in between are skipped, follow the
+    // manifest's parent arrays up to the level loaded before (cuts of one tree: the ancestor's flux is
+    // still the sum of its descendants'); the first loaded level has none.
+    for (Apl& a : level.apls) {
+      if (set.levels.empty()) {
+        a.parent = -1;
+        continue;
+      }
+      for (std::size_t up = k - 1; up > previous; --up) a.parent = manifest_.levels[up].parent[std::size_t(a.parent)];
+    }
     set.levels.push_back(std::move(level));
     previous = k;
   }

@@ -63,6 +63,16 @@ class Reader {
     if (it == obj.end()) fail(pointer + "/" + key, "missing");
     return *it;
   }
+  /// The schema's additionalProperties: false — a member the format does not define is an error
+  /// (a misspelt optional member would otherwise be silently ignored).
+  void only(const json& obj, const std::string& pointer, std::initializer_list<const char*> keys) const {
+    if (!obj.is_object()) fail(pointer, "expected an object");
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+      bool known = false;
+      for (const char* k : keys) known = known || it.key() == k;
+      if (!known) fail(pointer + "/" + it.key(), "is not a member the format defines");
+    }
+  }
   const json* optional_member(const json& obj, const char* key) const {
     auto it = obj.find(key);
     return it == obj.end() ? nullptr : &*it;
@@ -180,8 +190,12 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     d.field = "JSON";
     d.message = e.what();
     throw Error(std::move(d));
+  } catch (const json::exception& e) {  // e.g. a number beyond double's range (out_of_range 406)
+    r.fail("", std::string("not valid JSON for a manifest: ") + e.what());
   }
   if (!j.is_object()) r.fail("", "the manifest is not a JSON object");
+  r.only(j, "", {"format", "format_version", "generator", "units", "channels", "bounding_sphere", "provenance",
+                 "levels", "volume"});
   BundleManifest m;
   m.manifest_bytes = text.size();
   if (r.string(r.member(j, "", "format"), "/format") != bundle::kFormatName)
@@ -193,6 +207,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   m.generator = r.string(r.member(j, "", "generator"), "/generator");
 
   const json& units = r.member(j, "", "units");
+  r.only(units, "/units", {"length", "intensity", "flux", "irradiance"});
   const std::string length = r.string(r.member(units, "/units", "length"), "/units/length");
   if (length != "m") r.fail("/units/length", "must be \"m\"");
   const std::string intensity = r.string(r.member(units, "/units", "intensity"), "/units/intensity");
@@ -211,6 +226,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   const int nc = channel_count(m.channels);
 
   const json& bs = r.member(j, "", "bounding_sphere");
+  r.only(bs, "/bounding_sphere", {"center", "radius"});
   m.bounds.center = r.vec3(r.member(bs, "/bounding_sphere", "center"), "/bounding_sphere/center");
   m.bounds.radius = r.number(r.member(bs, "/bounding_sphere", "radius"), "/bounding_sphere/radius");
   if (m.bounds.radius < 0) r.fail("/bounding_sphere/radius", "negative");
@@ -228,6 +244,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   for (std::size_t k = 0; k < levels.size(); ++k) {
     const std::string at = "/levels/" + std::to_string(k);
     const json& lj = levels[k];
+    r.only(lj, at, {"apl_count", "map_resolution", "position", "flux", "parent", "maps", "error_vs_distance"});
     BundleLevelInfo l;
     const std::size_t n = std::size_t(r.integer(r.member(lj, at, "apl_count"), at + "/apl_count", 1,
                                                 (long long)limits.max_apls_per_level));
@@ -258,6 +275,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     if (maps.empty() || maps.size() > 16) r.fail(at + "/maps", "must list 1 to 16 payloads");
     for (std::size_t p = 0; p < maps.size(); ++p) {
       const std::string mp = at + "/maps/" + std::to_string(p);
+      r.only(maps[p], mp, {"file", "bytes", "sha256", "pixel_type", "resolution"});
       BundlePayload payload = r.payload(maps[p], mp, limits);
       payload.resolution = int(r.integer(r.member(maps[p], mp, "resolution"), mp + "/resolution", 1, sphere_map::kMaxResolution));
       const int expected = p == 0 ? l.map_resolution : l.maps.back().resolution / 2;
@@ -272,6 +290,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     }
     if (const json* e = r.optional_member(lj, "error_vs_distance")) {
       const std::string ep = at + "/error_vs_distance";
+      r.only(*e, ep, {"relative_distance", "relative_rmse"});
       const json& ds = r.array(r.member(*e, ep, "relative_distance"), ep + "/relative_distance", std::size_t(-1));
       const json& es = r.array(r.member(*e, ep, "relative_rmse"), ep + "/relative_rmse", ds.size());
       if (ds.size() > 4096) r.fail(ep, "more than 4096 entries");
@@ -289,14 +308,19 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   }
 
   if (const json* vj = r.optional_member(j, "volume")) {
+    r.only(*vj, "/volume", {"file", "bytes", "sha256", "pixel_type", "bounds", "counts", "voxel_size", "sh_bands",
+                            "channels", "window", "radiance_unit"});
     BundleVolumeInfo v;
     v.payload = r.payload(*vj, "/volume", limits);
     if (!files.insert(v.payload.file).second) r.fail("/volume/file", "\"" + v.payload.file + "\" is listed twice");
     const json& b = r.member(*vj, "/volume", "bounds");
+    r.only(b, "/volume/bounds", {"min", "max"});
     v.lo = r.vec3(r.member(b, "/volume/bounds", "min"), "/volume/bounds/min");
     v.hi = r.vec3(r.member(b, "/volume/bounds", "max"), "/volume/bounds/max");
     const json& counts = r.array(r.member(*vj, "/volume", "counts"), "/volume/counts", 3);
     for (int a = 0; a < 3; ++a) v.counts[a] = int(r.integer(counts[a], "/volume/counts/" + std::to_string(a), 1, 4096));
+    if (std::uint64_t(v.counts.x) * v.counts.y * v.counts.z > (1u << 24))
+      r.fail("/volume/counts", "more than 2^24 voxels");
     v.voxel_size = r.number(r.member(*vj, "/volume", "voxel_size"), "/volume/voxel_size");
     if (!(v.voxel_size > 0)) r.fail("/volume/voxel_size", "must be positive");
     for (int a = 0; a < 3; ++a)
@@ -310,6 +334,9 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     for (sh::Window w : {sh::Window::none, sh::Window::lanczos, sh::Window::hann, sh::Window::vallee_poussin})
       if (window == window_name(w)) v.window = w, known = true;
     if (!known) r.fail("/volume/window", "unknown window \"" + window + "\"");
+    const std::string unit = m.quantity == PhotometricQuantity::photometric ? "cd/m^2" : "W/(m^2 sr)";
+    if (r.string(r.member(*vj, "/volume", "radiance_unit"), "/volume/radiance_unit") != unit)
+      r.fail("/volume/radiance_unit", "must be \"" + unit + "\" for intensity in " + intensity);
     const std::uint64_t decoded = std::uint64_t(v.counts.x) * v.counts.y * v.counts.z * v.bands * v.bands * v.channels * 4;
     if (decoded > limits.max_decoded_bytes) r.fail("/volume", "would decode to " + std::to_string(decoded) + " bytes");
     m.volume = v;

@@ -90,52 +90,78 @@ std::string encode_exr(const ExrImage& image) {
   return out.take();
 }
 
-ExrImage decode_exr(std::string_view bytes, const std::string& file, int width, int height,
-                    const std::vector<std::string>& channels) {
+struct ExrReader::Impl {
+  MemoryIStream stream;
+  Imf::InputFile file;
+  Impl(std::string_view bytes, const std::string& name) : stream(bytes, name), file(stream) {}
+};
+
+ExrReader::ExrReader(std::string_view bytes, const std::string& file, int width, int height,
+                     const std::vector<std::string>& channels)
+    : impl_(nullptr), file_(file), width_(width), height_(height), channels_(channels) {
   try {
-    MemoryIStream in(bytes, file);
-    Imf::InputFile exr(in);
-    const Imath::Box2i window = exr.header().dataWindow();
+    impl_ = new Impl(bytes, file);
+    const Imf::Header& header = impl_->file.header();
+    const Imath::Box2i window = header.dataWindow();
     const long long w = (long long)window.max.x - window.min.x + 1;
     const long long h = (long long)window.max.y - window.min.y + 1;
-    if (window.min.x != 0 || window.min.y != 0)
-      fail(file, "dataWindow", "does not start at (0, 0)");
+    if (window.min.x != 0 || window.min.y != 0) fail(file, "dataWindow", "does not start at (0, 0)");
     if (w != width || h != height)
       fail(file, "dataWindow", "image is " + std::to_string(w) + " × " + std::to_string(h) + ", the manifest says " +
                                    std::to_string(width) + " × " + std::to_string(height));
-    ExrImage image;
-    image.width = width;
-    image.height = height;
-    image.channels = channels;
     std::size_t found = 0;
-    bool all_half = true;
-    for (auto it = exr.header().channels().begin(); it != exr.header().channels().end(); ++it) {
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
       if (std::find(channels.begin(), channels.end(), std::string(it.name())) == channels.end())
         fail(file, "channels", std::string("unexpected channel \"") + it.name() + "\"");
       if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
         fail(file, "channels", std::string("channel \"") + it.name() + "\" is subsampled");
-      all_half = all_half && it.channel().type == Imf::HALF;
+      half_ = half_ && it.channel().type == Imf::HALF;
       ++found;
     }
     if (found != channels.size())
       fail(file, "channels", "has " + std::to_string(found) + " channels, expected " + std::to_string(channels.size()));
-    image.half = all_half;
-    const std::size_t nc = channels.size();
-    image.pixels.assign(std::size_t(width) * std::size_t(height) * nc, 0.0f);
-    Imf::FrameBuffer frame;
-    for (std::size_t c = 0; c < nc; ++c)
-      frame.insert(channels[c], Imf::Slice(Imf::FLOAT, (char*)(image.pixels.data() + c),
-                                           sizeof(float) * nc, sizeof(float) * nc * std::size_t(width)));
-    exr.setFrameBuffer(frame);
-    exr.readPixels(0, height - 1);
-    return image;
   } catch (const Error&) {
+    delete impl_;
     throw;
   } catch (const std::exception& e) {
+    delete impl_;
     fail(file, "OpenEXR", e.what());
   }
 }
 
+ExrReader::~ExrReader() { delete impl_; }
+
+void ExrReader::read_rows(int y0, int y1, float* out) {
+  if (y0 < 0 || y1 < y0 || y1 >= height_) throw std::logic_error("ExrReader::read_rows: rows out of range");
+  try {
+    const std::size_t nc = channels_.size();
+    // OpenEXR addresses a slice by absolute (x, y); Slice::Make places `out` at the origin (0, y0).
+    const std::size_t row = nc * std::size_t(width_);
+    Imf::FrameBuffer frame;
+    for (std::size_t c = 0; c < nc; ++c)
+      frame.insert(channels_[c], Imf::Slice::Make(Imf::FLOAT, out + c, Imath::V2i(0, y0), width_, y1 - y0 + 1,
+                                                  sizeof(float) * nc, sizeof(float) * row));
+    impl_->file.setFrameBuffer(frame);
+    impl_->file.readPixels(y0, y1);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(file_, "OpenEXR", e.what());
+  }
+}
+
+ExrImage decode_exr(std::string_view bytes, const std::string& file, int width, int height,
+                    const std::vector<std::string>& channels) {
+  ExrReader reader(bytes, file, width, height, channels);
+  ExrImage image;
+  image.width = width;
+  image.height = height;
+  image.channels = channels;
+  image.half = reader.half();
+  image.pixels.assign(std::size_t(width) * std::size_t(height) * channels.size(), 0.0f);
+  reader.read_rows(0, height - 1, image.pixels.data());
+  return image;
+}
 
 }  // namespace detail
 LUMX_NAMESPACE_END

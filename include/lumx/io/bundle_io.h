@@ -2,8 +2,9 @@
 //
 // A bundle is a folder:
 //   manifest.json                  what is inside, validated by schema/bundle-manifest.schema.json
-//   levels/level_0008_r0256.exr    one OpenEXR image per (level, map resolution): the level's maps stacked
-//   levels/level_0008_r0128.exr    vertically (APL i occupies rows [i·R, (i+1)·R)), then the same maps
+//   levels/level01_n00008_r0256.exr  one OpenEXR image per (level index, APL count, map resolution): the
+//   levels/level01_n00008_r0128.exr  level's maps stacked vertically (APL i occupies rows [i·R, (i+1)·R)),
+//                                    then the same maps
 //   ...                            box-filtered to R/2, R/4, ... (flux-exact, see SphereMap::downsampled)
 //   volume.exr                     the radiance volume's SH coefficients (float), if any
 // Every payload's size and SHA-256 are in the manifest; maps are half floats unless a value exceeds half's
@@ -12,7 +13,7 @@
 //
 // Loading is partial by design ("a scene loads only what it needs"): BundleReader reads the manifest
 // alone; load_level() reads one level's payload at the largest stored resolution not above the caller's
-// limit, so a distant luminaire reads a few kilobytes. Every payload is size- and checksum-verified before
+// limit (the coarsest stored one if none is), so a distant luminaire reads a few kilobytes. Every payload is size- and checksum-verified before
 // OpenEXR parses it, and every count is checked against limits before anything is allocated.
 //
 // Writing is atomic at the folder level: the bundle is assembled in a temporary sibling folder, then
@@ -106,23 +107,36 @@ struct BundleLimits {
   std::uint64_t max_payload_bytes = 4ull << 30;
   std::size_t max_levels = 64;
   std::size_t max_apls_per_level = 1u << 20;
-  /// Largest decoded size of one payload in memory (float texels or coefficients).
-  std::uint64_t max_decoded_bytes = 16ull << 30;
+  /// Largest decoded size of one payload in memory (float texels or coefficients). A compressed payload
+  /// of a few megabytes can decode to gigabytes, so this bounds memory, not file size.
+  std::uint64_t max_decoded_bytes = 2ull << 30;
+  /// Largest total decoded size of one BundleReader::load() at full resolution.
+  std::uint64_t max_loaded_bytes = 8ull << 30;
 };
 
 /// Opens a bundle and reads its manifest only; levels and the volume are loaded on request.
 class BundleReader {
  public:
+  /// Keeps the folder open: every later load reads from the folder opened here, never through a
+  /// symbolic link, even if the path is renamed or re-pointed meanwhile.
   explicit BundleReader(const std::string& path, const BundleLimits& limits = {});
+  ~BundleReader();
+  BundleReader(BundleReader&& other) noexcept;
+  BundleReader(const BundleReader&) = delete;
+  BundleReader& operator=(const BundleReader&) = delete;
+  BundleReader& operator=(BundleReader&&) = delete;
 
   const BundleManifest& manifest() const { return manifest_; }
   const std::string& path() const { return path_; }
 
   /// The set's metadata (units, channels, bounds, provenance) with no levels.
   AplSet empty_set() const;
-  /// One level's APLs with maps at the largest stored resolution ≤ max_resolution (0 = full).
+  /// One level's APLs with maps at the largest stored resolution ≤ max_resolution (0 = full; the
+  /// coarsest stored resolution when max_resolution is below it).
   AplLevel load_level(std::size_t level, int max_resolution = 0) const;
-  /// The set with the chosen levels (all if empty), each at most max_resolution.
+  /// The set with the chosen levels (all if empty, increasing), each at most max_resolution. When levels
+  /// are skipped, parents are re-linked to their ancestor in the previous loaded level (the manifest keeps
+  /// every level's parent array), so the result is still a valid tree.
   AplSet load(const std::vector<std::size_t>& levels = {}, int max_resolution = 0) const;
   bool has_volume() const { return manifest_.volume.has_value(); }
   RadianceVolume load_volume() const;
@@ -137,6 +151,7 @@ class BundleReader {
   BundleLimits limits_;
   BundleManifest manifest_;
   mutable std::uint64_t bytes_read_ = 0;
+  int folder_fd_ = -1;
 };
 
 /// Findings of a full check: every payload read, checksums, the set's consistency (check_apl_set),
