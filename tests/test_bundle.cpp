@@ -471,7 +471,9 @@ TEST(Bundle, WriterOutputValidatesAgainstTheJsonSchema) {
   AplSet set = three_level_set(8);
   set.levels[1].error.relative_distance = {0.5, 1, 2};
   set.levels[1].error.relative_rmse = {0.2, 0.1, 0.05};
-  write_bundle(dir.string(), set, &volume);
+  BundleWriteOptions with_files;
+  with_files.attachments.push_back({"far_field.ies", "application/x-ies-lm63", format_ies(far_field_photometry(set, 0))});
+  write_bundle(dir.string(), set, &volume, with_files);
   const std::string validator = std::string(LUMX_SOURCE_DIR) + "/schema/validate.py";
   const std::string cmd = "/usr/bin/python3 " + validator + " " + dir.string() + " > " + (root / "out.txt").string() + " 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(root / "out.txt");
@@ -486,6 +488,34 @@ TEST(Bundle, WriterOutputValidatesAgainstTheJsonSchema) {
   EXPECT_NE(out.find("/units"), std::string::npos) << out;
   EXPECT_NE(out.find("/levels/0/maps/0/sha256"), std::string::npos) << out;
   EXPECT_NE(out.find("surprise"), std::string::npos) << out;
+}
+
+TEST(Bundle, AttachmentsShipWithTheSet) {
+  const AplSet set = three_level_set(8, ChannelLayout::luminance);
+  const fs::path root = scratch("attachments");
+  const fs::path dir = root / "a.lumx";
+  BundleWriteOptions o;
+  const std::string ies = format_ies(far_field_photometry(set, 0));
+  const std::string ldt = format_ldt(far_field_photometry(set, 0));
+  o.attachments = {{"far_field.ies", "application/x-ies-lm63", ies}, {"far_field.ldt", "application/x-eulumdat", ldt}};
+  write_bundle(dir.string(), set, nullptr, o);
+  BundleReader r(dir.string());
+  ASSERT_EQ(r.manifest().attachments.size(), 2u);
+  EXPECT_EQ(r.manifest().attachments[1].first.name, "far_field.ldt");
+  EXPECT_EQ(r.read_attachment(0), ies);
+  EXPECT_EQ(r.read_attachment(1), ldt);
+  EXPECT_TRUE(check_bundle(dir.string()).empty());
+  // Rewriting the bundle (attachments/ is part of a bundle) works; a corrupted attachment is found.
+  write_bundle(dir.string(), set, nullptr, o);
+  spit(dir / "attachments" / "far_field.ies", ies + " ");
+  const auto findings = check_bundle(dir.string());
+  ASSERT_EQ(findings.size(), 1u);
+  EXPECT_NE(findings[0].str().find("/attachments/0"), std::string::npos) << findings[0].str();
+  // Names that could leave the folder are refused.
+  BundleWriteOptions bad;
+  bad.attachments = {{"../x.ies", "text/plain", "x"}};
+  EXPECT_THROW(write_bundle((root / "b.lumx").string(), set, nullptr, bad), Error);
+  EXPECT_FALSE(fs::exists(root / "b.lumx"));
 }
 
 TEST(Bundle, VolumeRoundTrips) {

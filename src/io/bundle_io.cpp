@@ -132,9 +132,14 @@ void require_replaceable_bundle(const fs::path& target, const std::string& path)
   for (const auto& e : fs::directory_iterator(target)) {
     const std::string name = e.path().filename().string();
     const bool expected = (name == bundle::kManifestName && e.is_regular_file()) ||
-                          (name == "volume.exr" && e.is_regular_file()) || (name == "levels" && e.is_directory());
+                          (name == "volume.exr" && e.is_regular_file()) ||
+                          ((name == "levels" || name == "attachments") && e.is_directory());
     if (!expected) fail(path, "path", refuse + " (it holds \"" + name + "\")");
   }
+  if (fs::is_directory(target / "attachments"))
+    for (const auto& e : fs::directory_iterator(target / "attachments"))
+      if (!e.is_regular_file() || !detail::is_attachment_name(e.path().filename().string()))
+        fail(path, "path", refuse + " (attachments/ holds \"" + e.path().filename().string() + "\")");
   if (fs::is_directory(target / "levels"))
     for (const auto& e : fs::directory_iterator(target / "levels"))
       if (!e.is_regular_file() || e.path().extension() != ".exr")
@@ -166,6 +171,7 @@ std::uint64_t BundleManifest::total_bytes() const {
   for (const BundleLevelInfo& l : levels)
     for (const BundlePayload& p : l.maps) total += p.bytes;
   if (volume) total += volume->payload.bytes;
+  for (const auto& a : attachments) total += a.second.bytes;
   return total;
 }
 
@@ -243,6 +249,18 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
         if (!std::isfinite(c)) fail(path, "volume", "a coefficient is not finite");
       v.payload = write_payload(tmp, "volume.exr", image);
       m.volume = v;
+    }
+    if (!options.attachments.empty()) fs::create_directories(fs::path(tmp) / "attachments");
+    for (const BundleAttachment& a : options.attachments) {
+      if (!detail::is_attachment_name(a.name)) fail(path, "attachments", "\"" + a.name + "\" is not a valid file name");
+      for (const auto& [other, payload] : m.attachments)
+        if (other.name == a.name) fail(path, "attachments", "\"" + a.name + "\" is given twice");
+      BundlePayload p;
+      p.file = "attachments/" + a.name;
+      p.bytes = a.bytes.size();
+      p.sha256 = detail::sha256_hex(a.bytes);
+      write_file_atomically(join(tmp, p.file), a.bytes);
+      m.attachments.emplace_back(BundleAttachment{a.name, a.media_type, {}}, p);
     }
     // The writer's output must be what its reader accepts: parse it back before anything is replaced.
     const std::string manifest_text = detail::manifest_to_json(m);
@@ -455,6 +473,12 @@ AplSet BundleReader::load(const std::vector<std::size_t>& levels, int max_resolu
   return set;
 }
 
+std::string BundleReader::read_attachment(std::size_t index) const {
+  if (index >= manifest_.attachments.size())
+    fail(path_, "attachments", std::to_string(index) + " does not exist");
+  return read_payload(manifest_.attachments[index].second, "/attachments/" + std::to_string(index));
+}
+
 RadianceVolume BundleReader::load_volume() const {
   if (!manifest_.volume) fail(path_, "/volume", "the bundle has no radiance volume");
   const BundleVolumeInfo& v = *manifest_.volume;
@@ -518,6 +542,13 @@ std::vector<Diagnostic> check_bundle(const std::string& path, double flux_tolera
       out.push_back(e.diagnostic());
     } catch (const std::exception& e) {
       note(join(path, m.volume->payload.file), "volume", e.what());
+    }
+  }
+  for (std::size_t i = 0; i < m.attachments.size(); ++i) {
+    try {
+      reader->read_attachment(i);
+    } catch (const Error& e) {
+      out.push_back(e.diagnostic());
     }
   }
   if (!all_levels) return out;

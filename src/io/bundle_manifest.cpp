@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <cmath>
 #include <set>
 
@@ -12,6 +13,13 @@ LUMX_NAMESPACE_BEGIN
 namespace detail {
 
 using nlohmann::json;
+
+bool is_attachment_name(const std::string& name) {
+  if (name.empty() || name.size() > 128 || name == "." || name == "..") return false;
+  for (char c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') return false;
+  return true;
+}
 
 std::vector<std::string> map_channel_names(ChannelLayout layout) {
   return layout == ChannelLayout::rgb ? std::vector<std::string>{"R", "G", "B"} : std::vector<std::string>{"Y"};
@@ -163,6 +171,12 @@ std::string manifest_to_json(const BundleManifest& m) {
                                     {"relative_rmse", l.error.relative_rmse}};
     j["levels"].push_back(level);
   }
+  if (!m.attachments.empty()) {
+    j["attachments"] = json::array();
+    for (const auto& [a, p] : m.attachments)
+      j["attachments"].push_back(
+          {{"file", p.file}, {"bytes", p.bytes}, {"sha256", p.sha256}, {"media_type", a.media_type}});
+  }
   if (m.volume) {
     const BundleVolumeInfo& v = *m.volume;
     json vol = payload_json(v.payload, false);
@@ -195,7 +209,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   }
   if (!j.is_object()) r.fail("", "the manifest is not a JSON object");
   r.only(j, "", {"format", "format_version", "generator", "units", "channels", "bounding_sphere", "provenance",
-                 "levels", "volume"});
+                 "levels", "volume", "attachments"});
   BundleManifest m;
   m.manifest_bytes = text.size();
   if (r.string(r.member(j, "", "format"), "/format") != bundle::kFormatName)
@@ -307,6 +321,27 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     m.levels.push_back(std::move(l));
   }
 
+  if (const json* aj = r.optional_member(j, "attachments")) {
+    const json& list = r.array(*aj, "/attachments", std::size_t(-1));
+    if (list.size() > 64) r.fail("/attachments", "more than 64 attachments");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string at = "/attachments/" + std::to_string(i);
+      r.only(list[i], at, {"file", "bytes", "sha256", "media_type"});
+      BundleAttachment a;
+      BundlePayload p;
+      p.file = r.string(r.member(list[i], at, "file"), at + "/file");
+      const std::string prefix = "attachments/";
+      a.name = p.file.rfind(prefix, 0) == 0 ? p.file.substr(prefix.size()) : std::string();
+      if (!is_attachment_name(a.name)) r.fail(at + "/file", "must be attachments/NAME with NAME of [A-Za-z0-9._-]");
+      if (!files.insert(p.file).second) r.fail(at + "/file", "\"" + p.file + "\" is listed twice");
+      p.bytes = std::uint64_t(r.integer(r.member(list[i], at, "bytes"), at + "/bytes", 0, (long long)limits.max_payload_bytes));
+      p.sha256 = r.string(r.member(list[i], at, "sha256"), at + "/sha256");
+      if (p.sha256.size() != 64 || p.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
+        r.fail(at + "/sha256", "not 64 lowercase hexadecimal digits");
+      a.media_type = r.string(r.member(list[i], at, "media_type"), at + "/media_type");
+      m.attachments.emplace_back(std::move(a), std::move(p));
+    }
+  }
   if (const json* vj = r.optional_member(j, "volume")) {
     r.only(*vj, "/volume", {"file", "bytes", "sha256", "pixel_type", "bounds", "counts", "voxel_size", "sh_bands",
                             "channels", "window", "radiance_unit"});

@@ -15,6 +15,8 @@ namespace detail {
 
 std::string manifest_to_json(const BundleManifest& m);
 BundleManifest parse_manifest(std::string_view text, const std::string& file, const BundleLimits& limits);
+/// Attachment names: 1–128 of [A-Za-z0-9._-], not "." or "..".
+bool is_attachment_name(const std::string& name);
 /// Channel names as stored in map payloads: {"Y"} or {"R","G","B"}.
 std::vector<std::string> map_channel_names(ChannelLayout layout);
 /// Channel names of the volume payload: "sh00.R" ... one per (channel, coefficient), in memory order.

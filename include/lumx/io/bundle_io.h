@@ -7,6 +7,7 @@
 //                                    then the same maps
 //   ...                            box-filtered to R/2, R/4, ... (flux-exact, see SphereMap::downsampled)
 //   volume.exr                     the radiance volume's SH coefficients (float), if any
+//   attachments/NAME               files shipped with the set, e.g. its far field as IES and EULUMDAT
 // Every payload's size and SHA-256 are in the manifest; maps are half floats unless a value exceeds half's
 // range (65504) or the peak is so small that half would lose precision, in which case that payload is
 // float — never a silent Inf (hard-cases §3).
@@ -49,6 +50,13 @@ struct BundlePayload {
   int resolution = 0;         ///< map resolution R of this payload (maps only)
 };
 
+/// A file shipped inside the bundle (attachments/NAME), checksummed like every payload.
+struct BundleAttachment {
+  std::string name;        ///< file name: letters, digits, '.', '_' and '-' only
+  std::string media_type;  ///< e.g. "application/x-ies-lm63", "application/x-eulumdat"
+  std::string bytes;       ///< contents (writing); empty after reading the manifest
+};
+
 struct BundleLevelInfo {
   int map_resolution = 0;              ///< full resolution R of this level's maps
   std::vector<glm::vec3> position;     ///< m, one per APL
@@ -79,6 +87,7 @@ struct BundleManifest {
   std::map<std::string, std::string> provenance;
   std::vector<BundleLevelInfo> levels;
   std::optional<BundleVolumeInfo> volume;
+  std::vector<std::pair<BundleAttachment, BundlePayload>> attachments;  ///< name/type and file/bytes/sha256
   std::uint64_t manifest_bytes = 0;
 
   /// Bytes of every payload plus the manifest: what a full load reads.
@@ -94,6 +103,8 @@ struct BundleWriteOptions {
   MapPixelType pixel_type = MapPixelType::automatic;
   /// Store box-filtered copies of each level down to this resolution (0: full resolution only).
   int min_stored_resolution = 8;
+  /// Files to ship in attachments/ (names must be unique).
+  std::vector<BundleAttachment> attachments;
 };
 
 /// Writes `set` (and `volume`, if given) as a bundle folder at `path`, replacing an existing bundle
@@ -140,6 +151,8 @@ class BundleReader {
   AplSet load(const std::vector<std::size_t>& levels = {}, int max_resolution = 0) const;
   bool has_volume() const { return manifest_.volume.has_value(); }
   RadianceVolume load_volume() const;
+  /// The contents of attachment `index` (checksum verified).
+  std::string read_attachment(std::size_t index) const;
 
   /// Bytes read from disk through this reader so far (manifest included).
   std::uint64_t bytes_read() const { return bytes_read_; }
