@@ -55,6 +55,7 @@ void print_version() {
 
 int run_info(const InfoArgs& a) {
   if (is_bundle_path(a.file)) return run_bundle_info(a);
+  if (is_rayset_path(a.file)) return run_rayset_info(a);
   return guarded(a.file, [&] {
     std::vector<lumx::Diagnostic> warnings;
     const lumx::Photometry p = load(a.file, a.json ? &warnings : nullptr);
@@ -142,6 +143,8 @@ int run_check(const CheckArgs& a) {
     try {
       if (is_bundle_path(file)) {
         findings = lumx::check_bundle(file);
+      } else if (is_rayset_path(file)) {
+        findings = check_rayset(file);
       } else {
         const lumx::Photometry p = load(file, &findings);
         for (auto& d : lumx::validate(p)) findings.push_back(d);

@@ -1,6 +1,8 @@
 // The lumx command-line tool's subcommands. Each returns the process exit status; none calls exit().
 #pragma once
 
+#include <lumx/diagnostic.h>
+
 #include <string>
 #include <vector>
 
@@ -48,6 +50,14 @@ int run_bundle_info(const InfoArgs& a);
 int run_convert_to_bundle(const ConvertArgs& a);
 int run_convert_from_bundle(const ConvertArgs& a);
 int run_bundle_plot(const PlotArgs& a);
+
+/// True when `path` is a rayset (TM-25, LightTools, Zemax, plain text): by extension (.tm25ray, .ray) or
+/// content; .ies/.ldt files and folders never are (ray_commands.cpp).
+bool is_rayset_path(const std::string& path);
+/// Rayset variants: info (rays, flux header and summed, bounding box and sphere, spectrum, text fields) and
+/// the findings of reading every ray (warnings, or the located error).
+int run_rayset_info(const InfoArgs& a);
+std::vector<lumx::Diagnostic> check_rayset(const std::string& path);
 
 /// Prints the library, ABI and file-format versions.
 void print_version();

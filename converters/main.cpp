@@ -2,7 +2,9 @@
 //
 // Subcommands and their one-line help come from one table (kCommands); CLI11 renders `lumx --help`,
 // `lumx <cmd> --help` and usage errors (to stderr, exit status 2 or CLI11's code) from it.
+#include "build_command.h"
 #include "commands.h"
+#include "eval_commands.h"
 
 #include <CLI/CLI.hpp>
 
@@ -23,6 +25,8 @@ lumx_cli::InfoArgs g_info;
 lumx_cli::CheckArgs g_check;
 lumx_cli::ConvertArgs g_convert;
 lumx_cli::PlotArgs g_plot;
+lumx_cli::BuildArgs g_build;
+lumx_cli::EvalArgs g_eval;
 
 /// Refuses nan/inf for angle options (CLI11's number parsing accepts them).
 const CLI::Validator finite(
@@ -36,16 +40,20 @@ const CLI::Validator finite(
     "DEG");
 
 const Command kCommands[] = {
-    {"info", "Summarise a photometry file (IES or EULUMDAT: grid, flux, peak, beam/field angles) or a bundle "
-             "(levels, APLs, map resolutions, flux and bytes per level, volume grid)",
+    {"info", "Summarise a photometry file (IES or EULUMDAT: grid, flux, peak, beam/field angles), a bundle "
+             "(levels, APLs, map resolutions, flux and bytes per level, volume grid) or a rayset (TM-25, "
+             "LightTools, Zemax, plain text: rays, flux in the header and summed, bounding box and sphere, "
+             "spectrum, text fields)",
      [](CLI::App& c, int& st) {
-       c.add_option("file", g_info.file, "IES (.ies) or EULUMDAT (.ldt) file, or a bundle folder")->required();
+       c.add_option("file", g_info.file, "IES (.ies) or EULUMDAT (.ldt) file, a bundle folder, or a rayset")
+           ->required();
        c.add_flag("--json", g_info.json, "print the facts as JSON");
        c.callback([&st] { st = lumx_cli::run_info(g_info); });
      }},
     {"check", "Validate files or bundles strictly: 'FILE: OK' or located findings; exit status 1 on errors. "
               "Bundles: manifest rules, every payload's size and SHA-256, maps finite and non-negative, "
-              "flux equal across levels within 0.1 %",
+              "flux equal across levels within 0.1 %. Raysets: every ray read and checked (header, counts, "
+              "directions, fluxes); the header total against the rays' sum is a warning",
      [](CLI::App& c, int& st) {
        c.add_option("files", g_check.files, "files or bundle folders to check")->required();
        c.add_flag("--json", g_check.json, "print findings as JSON");
@@ -96,6 +104,61 @@ const Command kCommands[] = {
        c.add_option("--size", g_plot.size_px, "image size in pixels (default 800)")->check(CLI::Range(200, 8000));
        c.add_flag("--cd", g_plot.force_cd, "plot absolute cd even for relative photometry (default cd/klm)");
        c.callback([&st] { st = lumx_cli::run_plot(g_plot); });
+     }},
+    {"build", "Build a bundle from a rayset (TM-25, LightTools, Zemax, plain text): APL levels by agglomerative "
+              "clustering, each level's error against the rays (stored as error tables), the far field as IES and "
+              "EULUMDAT attachments; prints the speed-against-error table",
+     [](CLI::App& c, int& st) {
+       c.add_option("rays", g_build.rays, "rayset file")->required();
+       c.add_option("output", g_build.out, "bundle folder to write")->required();
+       c.add_option("--levels", g_build.levels, "APLs per level, increasing (default 1 8 64 256 512)");
+       c.add_option("--seeds", g_build.seed_rays, "rays the cluster tree is built from (default 250000)")
+           ->check(CLI::Range(std::size_t(1), std::size_t(1) << 30));
+       c.add_option("--map-resolution", g_build.map_resolution,
+                    "map resolution R for every level (default: by the rays-per-texel rule)")
+           ->check(CLI::Range(0, 4096));
+       c.add_option("--rays-per-texel", g_build.rays_per_texel, "the resolution rule's target (default 8)")
+           ->check(CLI::PositiveNumber);
+       c.add_option("--patches", g_build.patch_resolution, "error evaluation: N = 2R^2 patches per sphere (default 16)")
+           ->check(CLI::Range(1, 1024));
+       c.add_flag("--no-eval", g_build.no_eval, "skip the error evaluation (no error tables)");
+       c.add_option("--efficacy", g_build.efficacy_lm_per_w,
+                    "lm/W for the far field of rays in W (default: the header's luminous / radiant flux)")
+           ->check(finite);
+       c.add_flag("--progress", g_build.progress, "show the progress bar even when stderr is not a terminal");
+       c.callback([&st] { st = lumx_cli::run_build(g_build); });
+     }},
+    {"eval", "Irradiance of a bundle at given points (--points: 'x y z nx ny nz' per line, one value per line "
+             "out, lx or W/m^2), or its error against a rayset (--rays: relative RMSE, eq. 5.1, per level and the "
+             "far field on spheres at relative distances d, the rays' noise floor, ns per evaluation, bytes; "
+             "Hellinger and l2 distances; --plots for error against distance, time and bytes)",
+     [](CLI::App& c, int& st) {
+       c.add_option("bundle", g_eval.bundle, "bundle folder")->required();
+       c.add_option("--points", g_eval.points, "text file of points 'x y z nx ny nz' (m), '#' comments");
+       c.add_option("--level", g_eval.level, "--points: level index (default: the finest)")
+           ->check(CLI::NonNegativeNumber);
+       c.add_flag("--lod", g_eval.lod, "--points: level per point by relative distance (eq. 6.2), stochastic");
+       c.add_option("--seed", g_eval.seed, "--lod: seed of the per-line random choice (default 1)");
+       c.add_option("-o,--output", g_eval.out, "--points: output file (default: standard output)");
+       c.add_option("--rays", g_eval.rays, "rayset to evaluate the bundle against (TM-25, LightTools, Zemax, text)");
+       c.add_option("--patches", g_eval.patch_resolution,
+                    "--rays: patch resolution R, 2R^2 equal-area patches per sphere (default 16: 512)")
+           ->check(CLI::Range(1, 1024));
+       c.add_option("--subsamples", g_eval.subsamples,
+                    "--rays: k x k evaluation points per patch, 1 = the patch centre (default 0: per level, "
+                    "about one per map texel)")
+           ->check(CLI::Range(0, 16));
+       c.add_option("--distances", g_eval.distances,
+                    "--rays: relative distances d, comma-separated (default 0.5,0.75,1,2,5,10)")
+           ->delimiter(',')
+           ->check(CLI::PositiveNumber);
+       c.add_option("--plots", g_eval.plots_dir, "--rays: write error_vs_distance/time/bytes plots into DIR");
+       c.add_option("--plot-format", g_eval.plot_format, "--plots: png (default) or svg")
+           ->check(CLI::IsMember({"png", "svg"}));
+       c.add_flag("--json", g_eval.json, "--rays: print the report as JSON");
+       c.add_flag("--store-errors", g_eval.store_errors,
+                  "--rays: store each level's relative RMSE table in the bundle (read by the LOD error target)");
+       c.callback([&st] { st = lumx_cli::run_eval(g_eval); });
      }},
 };
 

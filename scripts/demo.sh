@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# README command 1: build everything, then run the main job on the bundled sample luminaires, all into
-# out/demo/: far-field photometry (info, check, IES -> LDT -> IES, polar plot), and a lumx bundle (the
-# ring luminaire sample's APL set and radiance volume: build, info, check, partial load and irradiance per
-# level, far-field export, map and position plots).
+# README command 1: build everything, then run the main job on the bundled samples, all into out/demo/:
+#  1. the measured OSRAM LED rayset (TM-25) -> a lumx bundle: APL levels by clustering, each level's error
+#     against the rays, the far field; prints the speed-against-error table, writes its plots;
+#  2. far-field photometry (info, check, IES -> LDT -> IES, polar plot);
+#  3. the ring-luminaire embedding example (APL set + radiance volume by hand, partial loading).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=$(bash scripts/build.sh | tail -n 1)
@@ -10,6 +11,15 @@ lumx="$dir/converters/lumx"
 sample=samples/downlight.ies
 out=out/demo
 mkdir -p "$out"
+rays=samples/osram_lertduw_blue_100k.tm25ray
+echo "== lumx info $rays"
+"$lumx" info "$rays"
+echo "== lumx build $rays -> $out/led.lumx (APL levels, error tables, far field)"
+rm -rf "$out/led.lumx"
+"$lumx" build "$rays" "$out/led.lumx" | tee "$out/led_build.txt"
+"$lumx" check "$out/led.lumx"
+"$lumx" eval "$out/led.lumx" --rays "$rays" --plots "$out/led_plots" > "$out/led_eval.txt"
+echo "(error-against-distance, -time and -bytes plots in $out/led_plots)"
 echo "== lumx info $sample"
 "$lumx" info "$sample" | tee "$out/info.txt"
 "$lumx" info --json "$sample" > "$out/info.json"

@@ -177,13 +177,16 @@ TEST(ClusterTree, DegenerateSeedsStillGiveATree) {
 }
 
 TEST(AplBuilder, MapResolutionRule) {
-  AplBuildOptions o;  // 8 rays per texel, R in [4, 256]
-  EXPECT_EQ(map_resolution_for(100, o), 4);            // too few rays: the minimum
-  EXPECT_EQ(map_resolution_for(8 * 2 * 64 * 64, o), 64);  // exactly 8 rays per texel at R = 64
-  EXPECT_EQ(map_resolution_for(8 * 2 * 64 * 64 - 1, o), 32);
-  EXPECT_EQ(map_resolution_for(1e12, o), 256);          // the maximum
-  o.rays_per_texel = 2;
-  EXPECT_EQ(map_resolution_for(2 * 2 * 16 * 16, o), 16);
+  AplBuildOptions o;  // 8 rays per texel over √n, R in [4, 256]
+  EXPECT_EQ(map_resolution_for(100, 1, o), 4);                     // too few rays: the minimum
+  EXPECT_EQ(map_resolution_for(8 * 2 * 64 * 64, 1, o), 64);        // exactly 8 rays per texel at R = 64
+  EXPECT_EQ(map_resolution_for(8 * 2 * 64 * 64 - 1, 1, o), 32);
+  EXPECT_EQ(map_resolution_for(4 * 8 * 2 * 32 * 32, 16, o), 32);   // √16 = 4 APLs' worth of budget
+  EXPECT_EQ(map_resolution_for(1e12, 1, o), 256);                  // the maximum
+  // The measured 100 k-ray LED: 64, 32, 16, 16, 16 for 1, 8, 64, 256, 512 APLs.
+  const int expected[] = {64, 32, 16, 16, 16};
+  const double apls[] = {1, 8, 64, 256, 512};
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(map_resolution_for(1e5, apls[i], o), expected[i]) << apls[i];
 }
 
 TEST(AplBuilder, EmittersBecomeApls) {
@@ -212,8 +215,8 @@ TEST(AplBuilder, EmittersBecomeApls) {
   EXPECT_EQ(report.rays, 32000u);
   EXPECT_EQ(report.seeds, 32000u);
   // Resolution by the rule: 32 000 rays over 1, 8, 64 APLs at 8 rays per texel.
-  EXPECT_EQ(report.map_resolution[0], map_resolution_for(32000.0, o));
-  EXPECT_EQ(report.map_resolution[2], map_resolution_for(500.0, o));
+  EXPECT_EQ(report.map_resolution[0], map_resolution_for(32000.0, 1, o));
+  EXPECT_EQ(report.map_resolution[2], map_resolution_for(32000.0, 64, o));
 }
 
 TEST(AplBuilder, HardCases) {

@@ -1,0 +1,111 @@
+// `lumx build RAYS OUT`: a rayset in, a bundle out — APL levels by clustering (lumx/apl_builder.h), the
+// error of every level against the rays on measurement spheres stored as the levels' error tables
+// (lumx/apl_error.h), and the rays' far field as IES and EULUMDAT attachments (lumx/ray_photometry.h);
+// then the speed-against-error table.
+#include "build_command.h"
+
+#include "cli_support.h"
+#include "eval_commands.h"
+#include "progress.h"
+
+#include <lumx/apl_builder.h>
+#include <lumx/apl_error.h>
+#include <lumx/intensity_table.h>
+#include <lumx/io/bundle_io.h>
+#include <lumx/io/photometry_io.h>
+#include <lumx/io/rayset_io.h>
+#include <lumx/ray_photometry.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+namespace lumx_cli {
+
+namespace {
+
+/// lm per W for the far field of a radiometric rayset: the caller's, else the header's Φv / Φe.
+double efficacy_for(const lumx::RaysetInfo& info, double given) {
+  if (given > 0) return given;
+  const auto v = info.values.find("luminous flux lm"), e = info.values.find("radiant flux W");
+  if (v != info.values.end() && e != info.values.end() && v->second > 0 && e->second > 0 && std::isfinite(v->second) &&
+      std::isfinite(e->second))
+    return v->second / e->second;
+  return 0;
+}
+
+}  // namespace
+
+int run_build(const BuildArgs& a) {
+  return guarded(a.rays, [&] {
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    lumx::RaysetReadOptions ro;
+    ro.warnings = [](const lumx::Diagnostic& d) { print_diag(d); };
+    std::unique_ptr<lumx::RaySource> rays = lumx::open_rayset(a.rays, ro);
+    const lumx::RaysetInfo& info = rays->info();
+    std::printf("rayset:   %s (%s %s), %llu rays, flux in %s\n", a.rays.c_str(), info.format.c_str(), info.version.c_str(),
+                (unsigned long long)info.ray_count, lumx::flux_unit(info.quantity));
+
+    // Levels by clustering.
+    lumx::AplBuildOptions bo;
+    if (!a.levels.empty()) bo.level_counts = a.levels;
+    bo.seed_rays = a.seed_rays;
+    bo.map_resolution = a.map_resolution;
+    bo.rays_per_texel = a.rays_per_texel;
+    lumx::AplBuildReport br;
+    lumx::AplSet set;
+    {
+      ProgressBar bar(double(info.ray_count), "rays", a.progress);
+      bo.progress = [&](double f, const char* phase) { bar.update(f, phase); };
+      set = lumx::build_apl_set(*rays, bo, &br);
+    }
+    set.provenance["source"] = a.rays;
+    std::printf("levels:   ");
+    for (std::size_t k = 0; k < set.levels.size(); ++k)
+      std::printf("%s%zu APLs (R %d)", k ? ", " : "", set.levels[k].size(), set.levels[k].map_resolution);
+    std::printf("\n          from %llu seeds: seeds %.2f s, tree %.2f s, assignment %.2f s\n",
+                (unsigned long long)br.seeds, br.seconds_seed, br.seconds_tree, br.seconds_assign);
+
+    // Error of every level against the rays, stored in the bundle for the LOD error-target rule.
+    lumx::AplErrorReport report;
+    const bool evaluate = !a.no_eval;
+    if (evaluate) {
+      lumx::AplErrorOptions eo;
+      eo.patch_resolution = a.patch_resolution;
+      ProgressBar bar(0, "", a.progress);
+      eo.progress = [&](double f, const char* phase) { bar.update(f, phase); };
+      report = lumx::evaluate_apl_errors(set, *rays, eo);
+      lumx::store_error_tables(set, report);
+    }
+
+    // The rays' far field as IES and EULUMDAT, shipped inside the bundle.
+    lumx::BundleWriteOptions wo;
+    lumx::FarFieldGrid grid;
+    grid.c_step_deg = a.c_step_deg;
+    grid.gamma_step_deg = a.gamma_step_deg;
+    grid.luminous_efficacy_lm_per_w = efficacy_for(info, a.efficacy_lm_per_w);
+    if (info.quantity == lumx::PhotometricQuantity::radiometric && !(grid.luminous_efficacy_lm_per_w > 0)) {
+      std::fprintf(stderr, "%s: note: the rays carry W and no luminous efficacy is known (give --efficacy LM_PER_W); "
+                           "no IES/EULUMDAT far field is attached\n", a.rays.c_str());
+    } else {
+      const lumx::Photometry far = lumx::far_field_from_rays(*rays, grid);
+      wo.attachments.push_back({"far_field.ies", "application/x-ies-lm63", lumx::format_ies(far)});
+      wo.attachments.push_back({"far_field.ldt", "application/x-eulumdat", lumx::format_ldt(far)});
+      std::printf("far field: %.2f lm (%s), attached as IES and EULUMDAT\n", lumx::IntensityTable(far).flux_lm(),
+                  info.quantity == lumx::PhotometricQuantity::radiometric
+                      ? ("rays in W at " + std::to_string(grid.luminous_efficacy_lm_per_w) + " lm/W").c_str()
+                      : "rays in lm");
+    }
+    lumx::write_bundle(a.out, set, nullptr, wo);
+    const lumx::BundleReader written(a.out);
+    std::printf("bundle:   %s, %llu bytes, written in %.2f s\n", a.out.c_str(),
+                (unsigned long long)written.manifest().total_bytes(),
+                std::chrono::duration<double>(Clock::now() - start).count());
+    if (evaluate) std::cout << "\n" << format_error_table(report, a.out, a.rays, set.quantity);
+    return 0;
+  });
+}
+
+}  // namespace lumx_cli

@@ -1,0 +1,25 @@
+// converters/build_command.h — `lumx build RAYS OUT`: a rayset in, a bundle out.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace lumx_cli {
+
+struct BuildArgs {
+  std::string rays, out;
+  std::vector<std::size_t> levels;   ///< --levels (default 1 8 64 256 512)
+  std::size_t seed_rays = 250000;    ///< --seeds
+  int map_resolution = 0;            ///< --map-resolution (0: by the rays-per-texel rule)
+  double rays_per_texel = 8;         ///< --rays-per-texel
+  int patch_resolution = 16;         ///< --patches R for the error evaluation
+  bool no_eval = false;              ///< --no-eval: skip the error evaluation (no error tables)
+  double c_step_deg = 2.5, gamma_step_deg = 1.0;  ///< far-field grid
+  double efficacy_lm_per_w = 0;      ///< --efficacy for radiometric rays (default: the header's Φv/Φe)
+  bool progress = false;             ///< --progress: show the bar even when stderr is not a terminal
+};
+
+int run_build(const BuildArgs& a);
+
+}  // namespace lumx_cli
