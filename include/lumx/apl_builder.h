@@ -35,6 +35,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 LUMX_NAMESPACE_BEGIN
@@ -47,6 +48,7 @@ struct AplBuildOptions {
   int min_resolution = 4, max_resolution = 256;
   double rays_per_texel = 8;        ///< the rule's target mean rays per texel
   std::size_t chunk_rays = 1 << 16; ///< rays per read
+  unsigned threads = 1;             ///< threads for the assignment pass (results do not depend on it)
   /// Called with the fraction done (0..1) and a phase name, at most a few hundred times.
   std::function<void(double, const char*)> progress;
 };
@@ -188,29 +190,61 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   }
   rays.rewind();
   std::uint64_t done = 0;
-  while (rays.next(chunk, options.chunk_rays)) {
-    for (std::size_t i = 0; i < chunk.size(); ++i) {
+  // Per ray: the finest APL and, per level, the texel (−1 for a ray without flux). Computed by up to
+  // `threads` threads over disjoint ranges of the chunk, then accumulated in ray order by this thread;
+  // the sums are integers, so the result is the same for any thread count and chunking.
+  const unsigned threads = std::max(1u, options.threads);
+  std::vector<std::int32_t> fine_of(options.chunk_rays);
+  std::vector<std::int32_t> texel_of_ray(options.chunk_rays * nl);
+  std::vector<std::int64_t> quanta(options.chunk_rays);
+  std::vector<std::string> errors(threads);
+  auto classify = [&](std::size_t begin, std::size_t end, std::string& error) {
+    for (std::size_t i = begin; i < end && error.empty(); ++i) {
       const float f = chunk.flux[i];
       const glm::vec3 p = chunk.position(i), w = chunk.direction(i);
       if (!(f >= 0) || !std::isfinite(f) || !std::isfinite(p.x + p.y + p.z) || !std::isfinite(w.x + w.y + w.z) ||
-          std::abs(glm::dot(w, w) - 1.0f) > 1e-3f)
-        throw std::invalid_argument("build_apl_set: ray " + std::to_string(done + i) +
-                                    " has a non-finite position, a negative or non-finite flux, or a direction "
-                                    "that is not a unit vector");
-      if (f == 0) {
-        ++rep.zero_flux_rays;
-        continue;
+          std::abs(glm::dot(w, w) - 1.0f) > 1e-3f) {
+        error = "build_apl_set: ray " + std::to_string(done + i) +
+                " has a non-finite position, a negative or non-finite flux, or a direction that is not a unit vector";
+        return;
       }
-      const std::int64_t q = std::int64_t(std::llround(double(f) / unit));
-      const std::uint32_t fine = nearest.nearest(p);
+      quanta[i] = f == 0 ? 0 : std::int64_t(std::llround(double(f) / unit));
+      fine_of[i] = f == 0 ? -1 : std::int32_t(nearest.nearest(p));
       for (std::size_t k = 0; k < nl; ++k) {
         int x, y;
         sphere_map::texel_of(w, set.levels[k].map_resolution, x, y);
-        const std::size_t apl = std::size_t(up[k][fine]);
-        sums[k][apl * std::size_t(texels[k]) + std::size_t(y) * std::size_t(2 * set.levels[k].map_resolution) + std::size_t(x)] += q;
+        texel_of_ray[i * nl + k] = y * 2 * set.levels[k].map_resolution + x;
       }
     }
-    done += chunk.size();
+  };
+  while (rays.next(chunk, options.chunk_rays)) {
+    const std::size_t n = chunk.size();
+    if (fine_of.size() < n) {
+      fine_of.resize(n);
+      texel_of_ray.resize(n * nl);
+      quanta.resize(n);
+    }
+    if (threads == 1 || n < 4096) {
+      classify(0, n, errors[0]);
+    } else {
+      std::vector<std::thread> pool;
+      for (unsigned t = 0; t < threads; ++t)
+        pool.emplace_back(classify, n * t / threads, n * (t + 1) / threads, std::ref(errors[t]));
+      for (std::thread& t : pool) t.join();
+    }
+    for (const std::string& e : errors)
+      if (!e.empty()) throw std::invalid_argument(e);  // the lowest range's first bad ray
+    for (std::size_t i = 0; i < n; ++i) {
+      if (fine_of[i] < 0) {
+        ++rep.zero_flux_rays;
+        continue;
+      }
+      for (std::size_t k = 0; k < nl; ++k) {
+        const std::size_t apl = std::size_t(up[k][std::size_t(fine_of[i])]);
+        sums[k][apl * std::size_t(texels[k]) + std::size_t(texel_of_ray[i * nl + k])] += quanta[i];
+      }
+    }
+    done += n;
     progress(0.2 + 0.8 * double(done) / double(total), "assign");
   }
   rep.rays = done;
