@@ -8,6 +8,7 @@
 #include <lumx/io/rayset_io.h>
 
 #include <gtest/gtest.h>
+#include "cli_test_support.h"
 #include <nlohmann/json.hpp>
 
 #include "test_support.h"
@@ -27,25 +28,10 @@ using namespace lumx;
 
 namespace {
 
-struct CliRun {
-  int status = -1;
-  std::string out;  // stdout (and stderr when merged)
-};
+using lumx_test::CliRun;
+CliRun run(const std::string& args, bool stderr_too = true) { return lumx_test::run_cli(args, stderr_too); }
 
-CliRun run(const std::string& args, bool stderr_too = true) {
-  const std::string cmd = std::string("\"") + LUMX_CLI_PATH + "\" " + args + (stderr_too ? " 2>&1" : " 2>/dev/null");
-  CliRun r;
-  FILE* f = popen(cmd.c_str(), "r");
-  if (!f) return r;
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), f)) > 0) r.out.append(buf.data(), n);
-  const int st = pclose(f);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
-
-std::string q(const fs::path& p) { return "\"" + p.string() + "\""; }
+std::string q(const fs::path& p) { return lumx_test::quoted(p); }
 
 fs::path scratch(const std::string& test) {
   const fs::path d = fs::temp_directory_path() / ("lumx_cli_eval_" + test + "_" + std::to_string(::getpid()));

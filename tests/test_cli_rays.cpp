@@ -1,6 +1,7 @@
 // `lumx info` and `lumx check` on raysets, as a user runs them: real files, a plain-text file, a broken
 // file (located finding, exit 1), and photometry files still taking their own path.
 #include <gtest/gtest.h>
+#include "cli_test_support.h"
 #include <nlohmann/json.hpp>
 
 #include "rayset_test_support.h"
@@ -17,27 +18,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-  int status = -1;
-  std::string out;  // stdout (and stderr when asked)
-};
+using lumx_test::CliRun;
+CliRun run(const std::string& args, bool stderr_too = true) { return lumx_test::run_cli(args, stderr_too); }
 
-CliRun run(const std::string& args, bool stderr_too = true) {
-  const std::string cmd = std::string("\"") + LUMX_CLI_PATH + "\" " + args + (stderr_too ? " 2>&1" : " 2>/dev/null");
-  CliRun r;
-  FILE* f = popen(cmd.c_str(), "r");
-  if (!f) return r;
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), f)) > 0) r.out.append(buf.data(), n);
-  const int st = pclose(f);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
-
-std::string q(const fs::path& p) {
-  return "\"" + p.string() + "\"";
-}
+std::string q(const fs::path& p) { return lumx_test::quoted(p); }
 
 bool has(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;

@@ -28,20 +28,22 @@ struct FarFieldGrid {
   double luminous_efficacy_lm_per_w = 0;
 };
 
+namespace detail {
+/// Steps of `step` degrees in `span` degrees: a whole number, at most 3600; throws naming `field`.
+inline int far_field_steps(double step, double span, const std::string& field) {
+  if (!(step > 0) || !std::isfinite(step) || std::abs(span / step - std::round(span / step)) > 1e-9 || span / step > 3600)
+    throw std::invalid_argument(field + " must divide " + std::to_string(int(span)) + "° into at most 3600 steps");
+  return int(std::round(span / step));
+}
+}  // namespace detail
+
 /// Type C photometry (absolute cd, full sphere) of `set.levels[level_index]` in the far-field limit.
 /// RGB sets export their Rec. 709 luminance Y.
 inline Photometry far_field_photometry(const AplSet& set, std::size_t level_index, const FarFieldGrid& grid = {}) {
   if (level_index >= set.levels.size())
     throw std::invalid_argument("far_field_photometry: level " + std::to_string(level_index) + " does not exist");
-  auto steps = [](double step, double span, const char* name) {
-    if (!(step > 0) || !std::isfinite(step) || std::abs(span / step - std::round(span / step)) > 1e-9 ||
-        span / step > 3600)
-      throw std::invalid_argument(std::string("far_field_photometry: ") + name + " must divide " +
-                                  std::to_string(int(span)) + "° into at most 3600 steps");
-    return int(std::round(span / step));
-  };
-  const int nc = steps(grid.c_step_deg, 360.0, "c_step_deg");
-  const int ng = steps(grid.gamma_step_deg, 180.0, "gamma_step_deg");
+  const int nc = detail::far_field_steps(grid.c_step_deg, 360.0, "far_field_photometry: c_step_deg");
+  const int ng = detail::far_field_steps(grid.gamma_step_deg, 180.0, "far_field_photometry: gamma_step_deg");
   double scale = 1.0;
   if (set.quantity == PhotometricQuantity::radiometric) {
     if (!(grid.luminous_efficacy_lm_per_w > 0) || !std::isfinite(grid.luminous_efficacy_lm_per_w))

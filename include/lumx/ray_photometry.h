@@ -24,15 +24,8 @@ LUMX_NAMESPACE_BEGIN
 /// Type C photometry (absolute cd) of every ray in `rays`, on `grid` (FarFieldGrid of apl_photometry.h;
 /// radiometric raysets need grid.luminous_efficacy_lm_per_w). Streams the rays once.
 inline Photometry far_field_from_rays(RaySource& rays, const FarFieldGrid& grid = {}) {
-  const auto steps = [](double step, double span, const char* name) {
-    if (!(step > 0) || !std::isfinite(step) || std::abs(span / step - std::round(span / step)) > 1e-9 ||
-        span / step > 3600)
-      throw std::invalid_argument(std::string("far_field_from_rays: ") + name + " must divide " +
-                                  std::to_string(int(span)) + "° into at most 3600 steps");
-    return int(std::round(span / step));
-  };
-  const int nc = steps(grid.c_step_deg, 360.0, "c_step_deg");
-  const int ng = steps(grid.gamma_step_deg, 180.0, "gamma_step_deg");
+  const int nc = detail::far_field_steps(grid.c_step_deg, 360.0, "far_field_from_rays: c_step_deg");
+  const int ng = detail::far_field_steps(grid.gamma_step_deg, 180.0, "far_field_from_rays: gamma_step_deg");
   double scale = 1.0;
   if (rays.info().quantity == PhotometricQuantity::radiometric) {
     if (!(grid.luminous_efficacy_lm_per_w > 0) || !std::isfinite(grid.luminous_efficacy_lm_per_w))
