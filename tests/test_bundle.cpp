@@ -103,6 +103,22 @@ std::string load_error(const fs::path& bundle) {
   return "";
 }
 
+/// Copies of a good bundle with one manifest edit each, and the located error each must produce.
+struct ManifestEdits {
+  fs::path root, good;
+  nlohmann::json manifest;
+  int n = 0;
+  void operator()(const std::function<void(nlohmann::json&)>& edit, const std::string& needle) {
+    const fs::path b = root / ("case" + std::to_string(n++) + ".lumx");
+    fs::copy(good, b, fs::copy_options::recursive);
+    nlohmann::json j = manifest;
+    edit(j);
+    write_manifest(b, j);
+    const std::string e = load_error(b);
+    EXPECT_NE(e.find(needle), std::string::npos) << "expected \"" << needle << "\" in: " << e;
+  }
+};
+
 }  // namespace
 
 TEST(Bundle, RoundTripKeepsTheSet) {
@@ -308,16 +324,7 @@ TEST(Bundle, InconsistentOrHostileManifestsAreRejected) {
   const fs::path good = root / "good.lumx";
   write_bundle(good.string(), set);
   const nlohmann::json m = read_manifest(good);
-  int n = 0;
-  auto expect = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& needle) {
-    const fs::path b = root / ("case" + std::to_string(n++) + ".lumx");
-    fs::copy(good, b, fs::copy_options::recursive);
-    nlohmann::json j = m;
-    edit(j);
-    write_manifest(b, j);
-    const std::string e = load_error(b);
-    EXPECT_NE(e.find(needle), std::string::npos) << "expected \"" << needle << "\" in: " << e;
-  };
+  ManifestEdits expect{root, good, m};
   expect([](auto& j) { j["levels"][1]["apl_count"] = 9; }, "/levels/1/position");
   expect([](auto& j) { j["levels"][2]["apl_count"] = 1000000; }, "/levels/2/position");  // no allocation first
   expect([](auto& j) { j["levels"][2]["parent"][3] = 8; }, "/levels/2/parent/3");
@@ -366,16 +373,7 @@ TEST(Bundle, VolumeManifestRulesAreEnforced) {
   RadianceVolume volume(Aabb{glm::dvec3(-0.1), glm::dvec3(0.1)}, 64, 2, 1);
   write_bundle(good.string(), three_level_set(8, ChannelLayout::luminance), &volume);
   const nlohmann::json m = read_manifest(good);
-  int n = 0;
-  auto expect = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& needle) {
-    const fs::path b = root / ("case" + std::to_string(n++) + ".lumx");
-    fs::copy(good, b, fs::copy_options::recursive);
-    nlohmann::json j = m;
-    edit(j);
-    write_manifest(b, j);
-    const std::string e = load_error(b);
-    EXPECT_NE(e.find(needle), std::string::npos) << "expected \"" << needle << "\" in: " << e;
-  };
+  ManifestEdits expect{root, good, m};
   expect([](auto& j) { j["volume"]["counts"] = {2, 4096, 4096}; }, "/volume/counts");  // > 2^24 voxels
   expect([](auto& j) { j["volume"]["radiance_unit"] = "W/(m^2 sr)"; }, "/volume/radiance_unit");
   expect([](auto& j) { j["volume"].erase("window"); }, "/volume/window");

@@ -16,11 +16,8 @@ namespace {
 constexpr std::uint64_t kHeader = 44;
 constexpr std::uint64_t kEndMarker = 7;  // "LTRFEND"
 
-std::string g(double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+/// Numbers in messages: the project's one format (text_scanner.h), 9 significant digits.
+std::string g(double v) { return format_number(v, 9); }
 
 /// LightTools length-unit codes (0 = the model's system unit, not stated in the file).
 std::optional<LengthUnit> lighttools_unit(std::uint32_t code) {

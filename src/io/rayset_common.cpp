@@ -25,24 +25,25 @@ void throw_at_offset(const std::string& file, std::int64_t offset, std::string f
   throw Error(std::move(d));
 }
 
-Diagnostic warning_at_offset(const std::string& file, std::int64_t offset, std::string field, std::string message) {
+/// A warning located by byte offset (offset ≥ 0) or by line (line > 0).
+static Diagnostic warning_at(const std::string& file, std::int64_t offset, int line, std::string field,
+                             std::string message) {
   Diagnostic d;
   d.severity = Severity::warning;
   d.file = file;
   d.byte_offset = offset;
+  d.line = line;
   d.field = std::move(field);
   d.message = std::move(message);
   return d;
 }
 
+Diagnostic warning_at_offset(const std::string& file, std::int64_t offset, std::string field, std::string message) {
+  return warning_at(file, offset, 0, std::move(field), std::move(message));
+}
+
 Diagnostic warning_at_line(const std::string& file, int line, std::string field, std::string message) {
-  Diagnostic d;
-  d.severity = Severity::warning;
-  d.file = file;
-  d.line = line;
-  d.field = std::move(field);
-  d.message = std::move(message);
-  return d;
+  return warning_at(file, -1, line, std::move(field), std::move(message));
 }
 
 // ---- RayFile ----

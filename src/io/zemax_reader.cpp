@@ -14,11 +14,8 @@ namespace {
 
 constexpr std::uint64_t kHeader = 208;
 
-std::string g(double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+/// Numbers in messages: the project's one format (text_scanner.h), 9 significant digits.
+std::string g(double v) { return format_number(v, 9); }
 
 std::optional<LengthUnit> zemax_unit(std::int64_t code) {
   switch (code) {
