@@ -55,6 +55,7 @@ int run_build(const BuildArgs& a) {
     bo.seed_rays = a.seed_rays;
     bo.map_resolution = a.map_resolution;
     bo.rays_per_texel = a.rays_per_texel;
+    bo.place_at_convergence = a.converge;
     bo.threads = a.threads > 0 ? a.threads : std::max(1u, std::thread::hardware_concurrency());
     lumx::AplBuildReport br;
     lumx::AplSet set;

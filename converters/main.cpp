@@ -126,6 +126,9 @@ const Command kCommands[] = {
                     "lm/W for the far field of rays in W (default: the header's luminous / radiant flux)")
            ->check(finite);
        c.add_flag("--progress", g_build.progress, "show the progress bar even when stderr is not a terminal");
+       c.add_flag("--converge", g_build.converge,
+                  "place each APL where its rays' lines converge (least squares) when that point lies inside the "
+                  "luminaire, instead of at its seeds' box centre: for rays recorded around a smaller emitter");
        c.add_option("--threads", g_build.threads, "threads for the ray assignment (default: every core; the bundle "
                                                   "is the same for any count)")
            ->check(CLI::Range(0u, 256u));

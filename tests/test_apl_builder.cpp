@@ -2,6 +2,7 @@
 // quality against exact greedy merging, nested cuts, flux conservation, hard cases (one point, duplicate
 // positions, fewer rays than APLs, zero-flux rays, flux spanning 10^6) and determinism.
 #include <lumx/apl_builder.h>
+#include <lumx/apl_error.h>
 #include <lumx/apl_photometry.h>
 #include <lumx/intensity_table.h>
 #include <lumx/ray_photometry.h>
@@ -327,4 +328,39 @@ TEST(RayFarField, MatchesTheAnalyticLobeAndLevelOne) {
   const glm::dvec3 down(0, 0, -1), slanted = glm::normalize(glm::dvec3(0.5, 0.0, -1.0));
   EXPECT_NEAR(IntensityTable(from_apl).intensity(slanted), table.intensity(slanted), 0.03 * table.max_cd());
   EXPECT_NEAR(IntensityTable(from_apl).intensity(down), table.intensity(down), 0.05 * table.max_cd());
+}
+
+TEST(AplBuilder, ConvergencePlacementFindsAnEnclosedEmitter) {
+  // Rays from a point emitter at the origin, recorded where they cross two caps at z = ±0.02 m (a
+  // cylinder of radius 0.01 m): the top cap sees the upward rays, the bottom cap the downward ones. APLs
+  // on the caps misplace the light; at the rays' convergence point they do not.
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  RayChunk c;
+  while (c.size() < 200000) {
+    const float z = 2 * u(rng) - 1, phi = float(2 * kPi) * u(rng), s = std::sqrt(1 - z * z);
+    const glm::vec3 w(s * std::cos(phi), s * std::sin(phi), z);
+    if (std::abs(z) < 0.9f) continue;  // only rays that leave through a cap
+    const float t = 0.02f / std::abs(z);
+    c.push_back(t * w, w, 1.0f);
+  }
+  MemoryRaySource rays(std::move(c), RaysetInfo{});
+  AplBuildOptions o;
+  o.level_counts = {1, 8};
+  o.map_resolution = 32;
+  AplErrorOptions eo;
+  eo.relative_distances = {1, 10};
+  eo.min_timing_seconds = 0;
+  const AplErrorReport on_caps = evaluate_apl_errors(build_apl_set(rays, o), rays, eo);
+  o.place_at_convergence = true;
+  AplBuildReport report;
+  const AplSet moved = build_apl_set(rays, o, &report);
+  EXPECT_EQ(report.moved_to_convergence, 9u);
+  for (const Apl& a : moved.levels[1].apls) EXPECT_LT(glm::length(a.position), 1e-3f);  // the emitter
+  EXPECT_TRUE(check_apl_set(moved).empty());
+  const AplErrorReport converged = evaluate_apl_errors(moved, rays, eo);
+  for (std::size_t s = 0; s < 2; ++s) {
+    EXPECT_LT(converged.levels[1].errors[s].relative_rmse, 0.5 * on_caps.levels[1].errors[s].relative_rmse) << s;
+    EXPECT_LT(converged.levels[1].errors[s].relative_rmse, 2 * converged.reference.sphere[s].noise_floor) << s;
+  }
 }

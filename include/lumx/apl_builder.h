@@ -4,7 +4,11 @@
 //      are often sorted by position or emitter, so "the first S" would seed one corner of the source).
 //   2. Tree: agglomerative clustering of the seeds' start points with eq. 4.1 (apl_clustering.h).
 //   3. Levels: cuts of the tree with 1, 8, 64, ... clusters; an APL sits at the centre of its seeds'
-//      bounding box; parents are the enclosing clusters of the previous cut.
+//      bounding box (000 §4.3); parents are the enclosing clusters of the previous cut. Optionally
+//      (AplBuildOptions::place_at_convergence), after step 4 an APL whose rays' lines meet near one point
+//      inside the luminaire moves there (least squares): a rayset recorded on a surface around a smaller
+//      emitter radiates from that emitter, not from the recording surface (Cyl1M_Faberge: 8 APLs on
+//      its caps are 13 % off at d = 10, one APL at the centre 2.5 %).
 //   4. Assignment: every ray of the file goes to the nearest APL centre of the finest level, and to that
 //      APL's ancestors in the coarser levels, so a parent's map is exactly the sum of its children's and
 //      the flux of every level is the rayset's flux. (Assigning each level by its own nearest centre
@@ -49,12 +53,17 @@ struct AplBuildOptions {
   double rays_per_texel = 8;        ///< the rule's target mean rays per texel
   std::size_t chunk_rays = 1 << 16; ///< rays per read
   unsigned threads = 1;             ///< threads for the assignment pass (results do not depend on it)
+  /// Place each APL where its rays' lines converge (see build_apl_set) instead of at its seeds' box
+  /// centre (000 §4.3), when that point is well defined and inside the luminaire's bound. Off by default:
+  /// it changes the dissertation's placement, and its effect on every kind of rayset is not yet charted.
+  bool place_at_convergence = false;
   /// Called with the fraction done (0..1) and a phase name, at most a few hundred times.
   std::function<void(double, const char*)> progress;
 };
 
 struct AplBuildReport {
   std::uint64_t rays = 0, seeds = 0, zero_flux_rays = 0;
+  std::size_t moved_to_convergence = 0;   ///< APLs placed at their rays' convergence point
   std::vector<int> map_resolution;        ///< per level
   std::vector<std::size_t> apl_count;     ///< per level (may be below the request for tiny raysets)
   double seconds_seed = 0, seconds_tree = 0, seconds_assign = 0;
@@ -188,6 +197,9 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
     texels[k] = 2 * R * R;
     sums[k].assign(std::size_t(texels[k]) * set.levels[k].apls.size(), 0);
   }
+  std::vector<glm::dmat3> normal(finest.size(), glm::dmat3(0.0));
+  std::vector<glm::dvec3> rhs(finest.size(), glm::dvec3(0.0));
+  std::vector<double> weight(finest.size(), 0.0);
   rays.rewind();
   std::uint64_t done = 0;
   // Per ray: the finest APL and, per level, the texel (−1 for a ray without flux). Computed by up to
@@ -243,6 +255,15 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
         const std::size_t apl = std::size_t(up[k][std::size_t(fine_of[i])]);
         sums[k][apl * std::size_t(texels[k]) + std::size_t(texel_of_ray[i * nl + k])] += quanta[i];
       }
+      if (options.place_at_convergence) {
+        // Σ Φ (I − ωωᵀ) and Σ Φ (I − ωωᵀ) p: the normal equations of the point nearest to the rays' lines.
+        const glm::dvec3 w(chunk.direction(i)), p(chunk.position(i));
+        const double f = double(chunk.flux[i]);
+        const glm::dmat3 P = glm::dmat3(1.0) - glm::outerProduct(w, w);
+        normal[std::size_t(fine_of[i])] += f * P;
+        rhs[std::size_t(fine_of[i])] += f * (P * p);
+        weight[std::size_t(fine_of[i])] += f;
+      }
     }
     done += n;
     progress(0.2 + 0.8 * double(done) / double(total), "assign");
@@ -268,6 +289,30 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   // The luminaire's bound: the box of the seeds' start points (the tree's root).
   set.bounds.center = glm::dvec3(tree.center(tree.root));
   set.bounds.radius = 0.5 * glm::length(glm::dvec3(tree.hi[std::size_t(tree.root)]) - glm::dvec3(tree.lo[std::size_t(tree.root)]));
+  if (options.place_at_convergence) {
+    // Each APL moves to the point nearest (least squares, flux-weighted) to its rays' lines, when the
+    // directions spread enough to fix it (det of the mean projector ≥ 1e-3; a beam within ~2° does
+    // not) and it lies inside the luminaire's bound. For rays leaving a surface in all directions this
+    // is near the surface; for rays recorded on a surface around a smaller emitter it is the emitter.
+    for (std::size_t k = 0; k < nl; ++k) {
+      std::vector<glm::dmat3> A(set.levels[k].size(), glm::dmat3(0.0));
+      std::vector<glm::dvec3> b(set.levels[k].size(), glm::dvec3(0.0));
+      std::vector<double> W(set.levels[k].size(), 0.0);
+      for (std::size_t i = 0; i < finest.size(); ++i) {
+        const std::size_t a = std::size_t(up[k][i]);
+        A[a] += normal[i];
+        b[a] += rhs[i];
+        W[a] += weight[i];
+      }
+      for (std::size_t a = 0; a < A.size(); ++a) {
+        if (!(W[a] > 0) || !(glm::determinant(A[a] / W[a]) >= 1e-3)) continue;
+        const glm::dvec3 x = glm::inverse(A[a]) * b[a];
+        if (!(glm::length(x - set.bounds.center) <= 1.001 * set.bounds.radius + 1e-9)) continue;
+        set.levels[k].apls[a].position = glm::vec3(x);
+        ++rep.moved_to_convergence;
+      }
+    }
+  }
   const auto t3 = Clock::now();
   rep.seconds_assign = seconds(t2, t3);
   progress(1.0, "done");
