@@ -80,14 +80,21 @@ class Error : public std::runtime_error {
   Diagnostic diag_;
 };
 
-/// Convenience: throw an Error about a field of a file without line numbers (binary files, folders, JSON
-/// located by a pointer in `field`).
-[[noreturn]] inline void throw_at_field(const std::string& file, std::string field, std::string message) {
+/// Convenience: throw an Error about a field of a file, located at a byte offset of a binary file
+/// (offset ≥ 0), or without a position (offset −1: folders, JSON located by a pointer in `field`).
+[[noreturn]] inline void throw_at_offset(const std::string& file, std::int64_t offset, std::string field,
+                                         std::string message) {
   Diagnostic d;
   d.file = file;
+  d.byte_offset = offset;
   d.field = std::move(field);
   d.message = std::move(message);
   throw Error(std::move(d));
+}
+
+/// Convenience: throw an Error about a field of a file without a position.
+[[noreturn]] inline void throw_at_field(const std::string& file, std::string field, std::string message) {
+  throw_at_offset(file, -1, std::move(field), std::move(message));
 }
 
 /// Convenience: throw an Error located at a line of a text file.

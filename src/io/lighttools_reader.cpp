@@ -16,29 +16,9 @@ namespace {
 constexpr std::uint64_t kHeader = 44;
 constexpr std::uint64_t kEndMarker = 7;  // "LTRFEND"
 
-/// Numbers in messages: the project's one format (text_scanner.h), 9 significant digits.
-std::string g(double v) { return format_number(v, 9); }
-
 /// LightTools length-unit codes (0 = the model's system unit, not stated in the file).
 std::optional<LengthUnit> lighttools_unit(std::uint32_t code) {
-  switch (code) {
-    case 1:
-      return length_unit_named("mm");
-    case 2:
-      return length_unit_named("cm");
-    case 3:
-      return length_unit_named("m");
-    case 4:
-      return length_unit_named("in");
-    case 5:
-      return length_unit_named("ft");
-    case 6:
-      return length_unit_named("um");
-    case 7:
-      return length_unit_named("nm");
-    default:
-      return std::nullopt;
-  }
+  return length_unit_coded(code, {"", "mm", "cm", "m", "in", "ft", "um", "nm"});
 }
 
 LengthUnit default_unit(const RaysetReadOptions& o, const std::string& file, std::int64_t offset, int line,
@@ -102,10 +82,10 @@ std::unique_ptr<RaySource> open_lighttools_binary(std::shared_ptr<const RayFile>
   need(40, 4, "total flux");
   const float total = le_f32(h + 40);
   if (!(total >= 0) || std::isinf(total))
-    throw_at_offset(path, 40, "total flux", "must be a non-negative number, is " + g(total));
+    throw_at_offset(path, 40, "total flux", "must be a non-negative number, is " + format_number_9(total));
   if ((ox != 0 || oy != 0 || oz != 0) && o.warnings)
     o.warnings(warning_at_offset(path, 28, "origin",
-                                 "data origin (" + g(ox) + ", " + g(oy) + ", " + g(oz) +
+                                 "data origin (" + format_number_9(ox) + ", " + format_number_9(oy) + ", " + format_number_9(oz) +
                                      ") is reported, not added: positions are read as stored"));
 
   const unsigned cols = colour == 2 ? 8 : 7;

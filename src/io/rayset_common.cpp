@@ -1,5 +1,6 @@
 // What the rayset readers and the TM-25 writer share (see rayset_common.h).
 #include "io/rayset_common.h"
+#include "io/text_scanner.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -16,14 +17,7 @@
 LUMX_NAMESPACE_BEGIN
 namespace detail {
 
-void throw_at_offset(const std::string& file, std::int64_t offset, std::string field, std::string message) {
-  Diagnostic d;
-  d.file = file;
-  d.byte_offset = offset;
-  d.field = std::move(field);
-  d.message = std::move(message);
-  throw Error(std::move(d));
-}
+std::string format_number_9(double v) { return format_number(v, 9); }
 
 /// A warning located by byte offset (offset ≥ 0) or by line (line > 0).
 static Diagnostic warning_at(const std::string& file, std::int64_t offset, int line, std::string field,

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -20,7 +21,6 @@
 LUMX_NAMESPACE_BEGIN
 namespace detail {
 
-[[noreturn]] void throw_at_offset(const std::string& file, std::int64_t offset, std::string field, std::string message);
 Diagnostic warning_at_offset(const std::string& file, std::int64_t offset, std::string field, std::string message);
 Diagnostic warning_at_line(const std::string& file, int line, std::string field, std::string message);
 
@@ -92,6 +92,15 @@ struct LengthUnit {
 };
 /// Units by the names the plain-text header and LightTools text use ("mm", "millimeters", ...).
 std::optional<LengthUnit> length_unit_named(std::string_view name);
+/// A format's numeric unit code: `names[code]` for 0 ≤ code < names.size() (an empty name means the
+/// code has no unit, e.g. LightTools' 0 = "system units"), else nullopt.
+inline std::optional<LengthUnit> length_unit_coded(std::int64_t code, std::initializer_list<const char*> names) {
+  if (code < 0 || code >= static_cast<std::int64_t>(names.size())) return std::nullopt;
+  const char* name = names.begin()[code];
+  return *name ? length_unit_named(name) : std::nullopt;
+}
+/// Numbers in ray-reader messages: the project's one format (text_scanner.h), 9 significant digits.
+std::string format_number_9(double v);
 /// TM-25 positions are mm: metres → mm such that reading gives back exactly `m` when any float in mm
 /// does (tm25_writer.cpp; docs/rays.md).
 float metres_to_tm25_mm(float m);

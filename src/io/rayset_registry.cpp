@@ -107,7 +107,7 @@ std::unique_ptr<RaySource> open_rayset(const std::string& path, const RaysetRead
   auto file = std::make_shared<const detail::RayFile>(path);
   const auto format = options.format ? options.format : format_of(*file, path);
   if (!format)
-    detail::throw_at_offset(path, 0, "format",
+    throw_at_offset(path, 0, "format",
                             "not a rayset lumx reads (TM-25, LightTools binary or text, Zemax binary or text, or "
                             "'# lumx-rays' plain text)");
   switch (*format) {
@@ -124,7 +124,7 @@ std::unique_ptr<RaySource> open_rayset(const std::string& path, const RaysetRead
     case RaysetFormat::plain_text:
       return detail::open_plain_rays(std::move(file), options);
   }
-  detail::throw_at_offset(path, 0, "format", "unknown format");
+  throw_at_offset(path, 0, "format", "unknown format");
 }
 
 RaysetSummary summarize_rays(RaySource& rays, std::size_t chunk_rays) {

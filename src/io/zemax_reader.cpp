@@ -14,25 +14,8 @@ namespace {
 
 constexpr std::uint64_t kHeader = 208;
 
-/// Numbers in messages: the project's one format (text_scanner.h), 9 significant digits.
-std::string g(double v) { return format_number(v, 9); }
-
-std::optional<LengthUnit> zemax_unit(std::int64_t code) {
-  switch (code) {
-    case 0:
-      return length_unit_named("m");
-    case 1:
-      return length_unit_named("in");
-    case 2:
-      return length_unit_named("cm");
-    case 3:
-      return length_unit_named("ft");
-    case 4:
-      return length_unit_named("mm");
-    default:
-      return std::nullopt;
-  }
-}
+/// Zemax dimension-unit codes.
+std::optional<LengthUnit> zemax_unit(std::int64_t code) { return length_unit_coded(code, {"m", "in", "cm", "ft", "mm"}); }
 
 }  // namespace
 
@@ -83,7 +66,7 @@ std::unique_ptr<RaySource> open_zemax_binary(std::shared_ptr<const RayFile> file
     throw_at_offset(path, 196, "flux type", "spectral ray data (format 2) is in W; flux type 1 (lm) contradicts it");
   need(200, 8, "reserved");
   if (!(set_flux >= 0) || std::isinf(set_flux))
-    throw_at_offset(path, 112, "ray set flux", "must be a non-negative number, is " + g(set_flux));
+    throw_at_offset(path, 112, "ray set flux", "must be a non-negative number, is " + format_number_9(set_flux));
 
   const unsigned cols = format == 2 ? 8 : 7;
   const std::uint64_t rec = 4u * cols;
@@ -174,11 +157,11 @@ std::unique_ptr<RaySource> open_zemax_text(std::shared_ptr<const RayFile> file, 
     throw_at_line(path, header_line, "header", "the first line must hold the ray count and the dimension-unit code");
   const double count = values[0];
   if (!(count >= 0 && count == std::floor(count) && count <= static_cast<double>(o.limits.max_rays)))
-    throw_at_line(path, header_line, "number of rays", "'" + g(count) + "' is not a ray count");
+    throw_at_line(path, header_line, "number of rays", "'" + format_number_9(count) + "' is not a ray count");
   const double code = values[1];
   const auto unit = code == std::floor(code) ? zemax_unit(static_cast<std::int64_t>(code)) : std::nullopt;
   if (!unit)
-    throw_at_line(path, header_line, "dimension units", "unknown code " + g(code) + " (0 m, 1 in, 2 cm, 3 ft, 4 mm)");
+    throw_at_line(path, header_line, "dimension units", "unknown code " + format_number_9(code) + " (0 m, 1 in, 2 cm, 3 ft, 4 mm)");
 
   TextRayLayout l;
   l.data_offset = lines.offset();
@@ -208,7 +191,7 @@ std::unique_ptr<RaySource> open_zemax_text(std::shared_ptr<const RayFile> file, 
   const std::uint64_t found = count_text_rays(f, l, o.warnings);
   if (found != static_cast<std::uint64_t>(count))
     throw_at_line(path, header_line, "number of rays",
-                  "the header says " + g(count) + " rays, the file has " + std::to_string(found) + " ray lines");
+                  "the header says " + format_number_9(count) + " rays, the file has " + std::to_string(found) + " ray lines");
 
   RaysetInfo info;
   info.file = path;
