@@ -114,7 +114,9 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   seed_flux.reserve(std::size_t(want));
   rays.rewind();
   std::uint64_t index = 0;
+  float max_flux = 0;  // for the fixed-point unit of step 5, gathered in this pass over every ray
   while (rays.next(chunk, options.chunk_rays)) {
+    for (float f : chunk.flux) max_flux = std::max(max_flux, std::isfinite(f) ? f : 0.0f);
     for (std::size_t i = 0; i < chunk.size(); ++i, ++index) {
       // Ray `index` is a seed when ⌊(index+1)·S/N⌋ > ⌊index·S/N⌋: exactly S seeds, evenly spaced.
       if ((index + 1) * want / total == index * want / total) continue;
@@ -183,10 +185,6 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   }
 
   // ---- 4.–5. assignment and maps, in 64-bit fixed point (order-independent sums)
-  float max_flux = 0;
-  rays.rewind();
-  while (rays.next(chunk, options.chunk_rays))
-    for (float f : chunk.flux) max_flux = std::max(max_flux, std::isfinite(f) ? f : 0.0f);
   if (!(max_flux > 0)) throw std::invalid_argument("build_apl_set: no ray carries flux");
   // One unit = max_flux · 2^-40: 10^10 rays of the largest flux still fit in 2^63.
   const double unit = double(max_flux) * std::ldexp(1.0, -40);
