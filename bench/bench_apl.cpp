@@ -10,6 +10,7 @@
 //   irradiance/N      irradiance(x, n) summed over level N at random shading points in a 2 m box, and at
 //                     coherent ones (a raster of neighbouring points, as a renderer's pixels are);
 //                     ns_per_light = time / N, to compare with bare_lookup
+//   atan2f_alone, direction_to_square, sh_evaluate_4_bands   the pieces a lookup and a volume deposit use
 //   sample/pdf        SphereMapSampler on a 256 × 512 map
 //   volume            RadianceVolume::radiance at random points and directions (32³, 4 bands, RGB)
 // Bytes per level (memory and disk) are printed by the `bundle_bytes` benchmark as counters.
@@ -17,6 +18,7 @@
 #include <lumx/apl_set.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/radiance_volume.h>
+#include <lumx/spherical_harmonics.h>
 #include <lumx/sphere_map_sampler.h>
 
 #include <benchmark/benchmark.h>
@@ -121,6 +123,30 @@ void intensity(benchmark::State& state) {
   over_random_directions(state, 2, [&](const glm::vec3& w) { return map.lookup(w); });
 }
 BENCHMARK(intensity);
+
+// What the direction → square map costs, against glibc's atan2f that it replaced (sphere_map.h).
+void atan2f_alone(benchmark::State& state) {
+  over_random_directions(state, 3, [](const glm::vec3& w) { return std::atan2(w.y, w.x); });
+}
+BENCHMARK(atan2f_alone);
+
+void direction_to_square(benchmark::State& state) {
+  over_random_directions(state, 3, [](const glm::vec3& w) {
+    int half;
+    return sphere_map::direction_to_square(w, half);
+  });
+}
+BENCHMARK(direction_to_square);
+
+// Real SH up to band 3 (16 coefficients), Sloan's recurrences (spherical_harmonics.h).
+void sh_evaluate_4_bands(benchmark::State& state) {
+  float y[16];
+  over_random_directions(state, 4, [&](const glm::vec3& w) {
+    sh::evaluate(glm::dvec3(w), 4, y);
+    return y[15];
+  });
+}
+BENCHMARK(sh_evaluate_4_bands);
 
 void bare_lookup(benchmark::State& state) {
   const AplLevel& level = big_set().levels[4];

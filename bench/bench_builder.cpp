@@ -7,9 +7,11 @@
 //   build/N/T        build_apl_set over N synthetic rays (250 k seeds, levels 1…512) with T assignment
 //                    threads, then write_bundle; 10 M rays on 2 threads is the "< 60 s" target.
 //                    peak_rss_MiB is the process's high-water mark (the 10 M rays themselves are 280 MB).
+//   read_tm25/N      stream an N-ray TM-25 file (written first) from the page cache: throughput, memory
 // Rays: 64 emitters on a 0.3 m ring, 1 mm discs, cos³ lobes tilted outwards, in memory (SoA floats).
 #include <lumx/apl_builder.h>
 #include <lumx/io/bundle_io.h>
+#include <lumx/io/rayset_io.h>
 
 #include <unistd.h>
 
@@ -96,6 +98,45 @@ void build(benchmark::State& state) {
   state.counters["peak_rss_MiB"] = peak_rss_mib();
 }
 BENCHMARK(build)->Args({1000000, 1})->Args({10000000, 1})->Args({10000000, 2})->Unit(benchmark::kSecond)->Iterations(1);
+
+/// Streaming a TM-25 file from the page cache: written once with write_tm25, then read whole by
+/// summarize_rays (two passes). bytes_per_second counts both passes; peak_rss_MiB is the whole process's
+/// high-water mark (writing and reading), against a file of file_MiB.
+void read_tm25(benchmark::State& state) {
+  const std::size_t n = std::size_t(state.range(0));
+  const std::string path = (std::filesystem::temp_directory_path() / ("lumx_bench_" + std::to_string(::getpid()) + ".tm25ray")).string();
+  {
+    // Generated chunk by chunk, so writing does not raise the memory high-water mark either.
+    class RingSource final : public RaySource {
+     public:
+      explicit RingSource(std::size_t total) { info_.file = "ring", info_.ray_count = total; }
+      const RaysetInfo& info() const override { return info_; }
+      bool next(RayChunk& out, std::size_t max_rays) override {
+        const std::size_t m = std::min<std::size_t>(max_rays, info_.ray_count - done_);
+        if (m == 0) return false;
+        out = ring_rays(m, unsigned(done_ + 3));
+        done_ += m;
+        return true;
+      }
+      void rewind() override { done_ = 0; }
+
+     private:
+      RaysetInfo info_;
+      std::size_t done_ = 0;
+    } source(n);
+    write_tm25(path, source.info(), source);
+  }
+  const double file_bytes = double(std::filesystem::file_size(path));
+  for (auto _ : state) {
+    const auto rays = open_rayset(path);
+    benchmark::DoNotOptimize(summarize_rays(*rays));
+  }
+  state.counters["peak_rss_MiB"] = peak_rss_mib();
+  state.counters["file_MiB"] = file_bytes / (1 << 20);
+  state.SetBytesProcessed(std::int64_t(2 * file_bytes) * std::int64_t(state.iterations()));  // two passes
+  std::filesystem::remove(path);
+}
+BENCHMARK(read_tm25)->Arg(10000000)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 
