@@ -73,7 +73,8 @@ inline glm::vec2 disk_to_square(float rho, float phi) {
 }
 
 /// atan(t) for t ∈ [−1, 1]: an odd minimax polynomial t·P(t²) of degree 15, within 1.3e-7 rad in float
-/// (about one float ulp of π/4). glibc's atan2f costs ~35 ns here, most of a map lookup; this ~3 ns.
+/// (about one float ulp of π/4). glibc's atan2f costs ~25 ns here; the whole direction → square map with
+/// this ~8 ns (bench/bench_apl.cpp: atan2f_alone, direction_to_square).
 inline float atan_unit(float t) {
   const float u = t * t;
   float p = -0.004054541713648427f;
