@@ -18,7 +18,8 @@ struct BuildArgs {
   double c_step_deg = 2.5, gamma_step_deg = 1.0;  ///< far-field grid
   double efficacy_lm_per_w = 0;      ///< --efficacy for radiometric rays (default: the header's Φv/Φe)
   bool progress = false;             ///< --progress: show the bar even when stderr is not a terminal
-  bool converge = false;             ///< --converge: APLs at their rays' convergence point
+  bool converge = true;              ///< --converge / --no-converge: rays as lines (AplBuildOptions)
+  double apl_exponent = 0;           ///< --resolution-exponent
   unsigned threads = 0;              ///< --threads (0: every core); the bundle does not depend on it
 };
 

@@ -126,9 +126,14 @@ const Command kCommands[] = {
                     "lm/W for the far field of rays in W (default: the header's luminous / radiant flux)")
            ->check(finite);
        c.add_flag("--progress", g_build.progress, "show the progress bar even when stderr is not a terminal");
-       c.add_flag("--converge", g_build.converge,
-                  "place each APL where its rays' lines converge (least squares) when that point lies inside the "
-                  "luminaire, instead of at its seeds' box centre: for rays recorded around a smaller emitter");
+       c.add_flag("--converge,!--no-converge", g_build.converge,
+                  "treat rays as lines: cluster them by where they come from and place each APL where its rays' "
+                  "lines converge (least squares), when inside the luminaire (default); --no-converge: cluster "
+                  "start points and place APLs at their box centres (the dissertation's rule)");
+       c.add_option("--resolution-exponent", g_build.apl_exponent,
+                    "the resolution rule's n^e, 2R^2 <= N/(rays-per-texel * n^e): 0 = the level's rays (default), "
+                    "1 = one APL's")
+           ->check(CLI::Range(0.0, 1.0));
        c.add_option("--threads", g_build.threads, "threads for the ray assignment (default: every core; the bundle "
                                                   "is the same for any count)")
            ->check(CLI::Range(0u, 256u));

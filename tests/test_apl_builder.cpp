@@ -178,16 +178,29 @@ TEST(ClusterTree, DegenerateSeedsStillGiveATree) {
 }
 
 TEST(AplBuilder, MapResolutionRule) {
-  AplBuildOptions o;  // 8 rays per texel over √n, R in [4, 256]
+  AplBuildOptions o;  // 8 rays per texel over the level's rays (n^0), R in [4, 128]
   EXPECT_EQ(map_resolution_for(100, 1, o), 4);                     // too few rays: the minimum
   EXPECT_EQ(map_resolution_for(8 * 2 * 64 * 64, 1, o), 64);        // exactly 8 rays per texel at R = 64
   EXPECT_EQ(map_resolution_for(8 * 2 * 64 * 64 - 1, 1, o), 32);
+  EXPECT_EQ(map_resolution_for(8 * 2 * 64 * 64, 512, o), 64);      // the level's budget: n does not enter
+  EXPECT_EQ(map_resolution_for(1e12, 1, o), 128);                  // the maximum
+  o.apl_exponent = 0.5;                                            // geometric mean of level and APL budgets
   EXPECT_EQ(map_resolution_for(4 * 8 * 2 * 32 * 32, 16, o), 32);   // √16 = 4 APLs' worth of budget
-  EXPECT_EQ(map_resolution_for(1e12, 1, o), 256);                  // the maximum
-  // The measured 100 k-ray LED: 64, 32, 16, 16, 16 for 1, 8, 64, 256, 512 APLs.
-  const int expected[] = {64, 32, 16, 16, 16};
+  EXPECT_EQ(map_resolution_for(4 * 8 * 2 * 32 * 32 - 1, 16, o), 16);
+  o.apl_exponent = 1;                                              // one APL's budget
+  EXPECT_EQ(map_resolution_for(64 * 8 * 2 * 16 * 16, 64, o), 16);
+  // The measured 100 k-ray LED, 1, 8, 64, 256, 512 APLs: 64 everywhere by default; 64, 32, 16, 16, 16 with
+  // the geometric mean; 64, 16, 8, 4, 4 per APL.
   const double apls[] = {1, 8, 64, 256, 512};
-  for (int i = 0; i < 5; ++i) EXPECT_EQ(map_resolution_for(1e5, apls[i], o), expected[i]) << apls[i];
+  const int level[] = {64, 64, 64, 64, 64}, mean[] = {64, 32, 16, 16, 16}, per_apl[] = {64, 16, 8, 4, 4};
+  for (int i = 0; i < 5; ++i) {
+    o.apl_exponent = 0;
+    EXPECT_EQ(map_resolution_for(1e5, apls[i], o), level[i]) << apls[i];
+    o.apl_exponent = 0.5;
+    EXPECT_EQ(map_resolution_for(1e5, apls[i], o), mean[i]) << apls[i];
+    o.apl_exponent = 1;
+    EXPECT_EQ(map_resolution_for(1e5, apls[i], o), per_apl[i]) << apls[i];
+  }
 }
 
 TEST(AplBuilder, EmittersBecomeApls) {
@@ -351,6 +364,7 @@ TEST(AplBuilder, ConvergencePlacementFindsAnEnclosedEmitter) {
   AplErrorOptions eo;
   eo.relative_distances = {1, 10};
   eo.min_timing_seconds = 0;
+  o.place_at_convergence = false;  // the dissertation's rule: APLs at their seeds' box centres
   const AplErrorReport on_caps = evaluate_apl_errors(build_apl_set(rays, o), rays, eo);
   o.place_at_convergence = true;
   AplBuildReport report;
@@ -363,4 +377,56 @@ TEST(AplBuilder, ConvergencePlacementFindsAnEnclosedEmitter) {
     EXPECT_LT(converged.levels[1].errors[s].relative_rmse, 0.5 * on_caps.levels[1].errors[s].relative_rmse) << s;
     EXPECT_LT(converged.levels[1].errors[s].relative_rmse, 2 * converged.reference.sphere[s].noise_floor) << s;
   }
+}
+
+TEST(LineFit, NearestPointEigenSolveAndShiftSums) {
+  // Lines through (1, 2, 3) in four directions: the nearest point is (1, 2, 3), at distance 0.
+  const glm::vec3 c(1, 2, 3);
+  LineFit fit;
+  const glm::vec3 dirs[] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, glm::normalize(glm::vec3(1, 1, 1))};
+  for (int i = 0; i < 4; ++i) fit.add(c + float(i + 1) * dirs[i], dirs[i], 1.0f + float(i));
+  const glm::dvec3 x = fit.solve(glm::dvec3(0.0), 1e-6);
+  EXPECT_NEAR(glm::length(x - glm::dvec3(c)), 0.0, 1e-5);
+  EXPECT_NEAR(fit.mean_line_distance2(x), 0.0, 1e-9);
+  // Start points at distances 1, 2, 3, 4 with weights 1..4: Σ w d² / Σ w = (1 + 8 + 27 + 64) / 10.
+  EXPECT_NEAR(fit.mean_start_distance2(glm::dvec3(c)), 10.0, 1e-4);
+  // A point off the lines: its mean squared distance across them, by hand for the axis lines.
+  LineFit axis;
+  axis.add({0, 0, 0}, {0, 0, 1}, 2.0f);
+  EXPECT_NEAR(axis.mean_line_distance2({3, 4, 7}), 25.0, 1e-9);
+  // Parallel lines (a beam) do not fix the coordinate along them: it comes from the anchor; across the
+  // beam the lines decide (their mean, 0.5, 0), whatever the anchor says.
+  LineFit beam;
+  beam.add({0, 0, 5}, {0, 0, 1}, 1.0f);
+  beam.add({0, 1, -2}, {0, 0, 1}, 1.0f);
+  const glm::dvec3 y = beam.solve({9, 9, 0.25}, 1e-3);
+  EXPECT_NEAR(y.x, 0.0, 1e-9);
+  EXPECT_NEAR(y.y, 0.5, 1e-9);
+  EXPECT_NEAR(y.z, 0.25, 1e-9);
+  // Merging fits with different origins equals adding the lines to one fit.
+  LineFit a, b, both;
+  std::mt19937 rng(3);
+  std::normal_distribution<float> g;
+  for (int i = 0; i < 200; ++i) {
+    const glm::vec3 p(100 + g(rng), -50 + g(rng), g(rng)), w = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+    (i < 100 ? a : b).add(p, w, 1.0f + float(i % 7));
+    both.add(p, w, 1.0f + float(i % 7));
+  }
+  a.add(b);
+  const glm::dvec3 q(101, -49, 0.5);
+  EXPECT_NEAR(a.mean_line_distance2(q), both.mean_line_distance2(q), 1e-9 * both.mean_line_distance2(q));
+  EXPECT_NEAR(a.mean_start_distance2(q), both.mean_start_distance2(q), 1e-9 * both.mean_start_distance2(q));
+  EXPECT_NEAR(glm::length(a.solve(q, 1e-6) - both.solve(q, 1e-6)), 0.0, 1e-9);
+  // Eigen-decomposition: M V = V diag(λ).
+  const glm::dmat3 M(4, 1, 0.5, 1, 3, -0.25, 0.5, -0.25, 1);
+  glm::dvec3 l;
+  glm::dmat3 V;
+  LineFit::symmetric_eigen(M, l, V);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(glm::length(M * V[i] - l[i] * V[i]), 0.0, 1e-12);
+  // Bad rays are left out.
+  LineFit bad;
+  bad.add({0, 0, 0}, {0, 0, 2}, 1.0f);
+  bad.add({NAN, 0, 0}, {0, 0, 1}, 1.0f);
+  bad.add({0, 0, 0}, {0, 0, 1}, -1.0f);
+  EXPECT_EQ(bad.weight, 0.0);
 }

