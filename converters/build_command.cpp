@@ -57,6 +57,7 @@ int run_build(const BuildArgs& a) {
     bo.rays_per_texel = a.rays_per_texel;
     bo.place_at_convergence = a.converge;
     bo.apl_exponent = a.apl_exponent;
+    bo.map_smoothing_rays = a.smooth_rays;
     bo.threads = a.threads > 0 ? a.threads : std::max(1u, std::thread::hardware_concurrency());
     lumx::AplBuildReport br;
     lumx::AplSet set;
@@ -71,10 +72,14 @@ int run_build(const BuildArgs& a) {
       std::printf("%s%zu APLs (R %d)", k ? ", " : "", set.levels[k].size(), set.levels[k].map_resolution);
     std::printf("\n          from %llu seeds: seeds %.2f s, tree %.2f s, assignment %.2f s\n",
                 (unsigned long long)br.seeds, br.seconds_seed, br.seconds_tree, br.seconds_assign);
-    if (a.converge && !br.shift_by_start.empty()) {
-      std::printf("lines:    mean squared shift across the rays per level, mm^2, by start point / by line:");
-      for (std::size_t k = 0; k < br.shift_by_start.size() && k < br.shift_by_line.size(); ++k)
-        std::printf(" %.3g/%.3g", br.shift_by_start[k] * 1e6, br.shift_by_line[k] * 1e6);
+    if (a.converge) {
+      std::printf("lines:    RMS distance from their convergence point / start points' %.3f (<= 0.85 to cluster by line)",
+                  br.line_convergence);
+      if (!br.shift_by_start.empty()) {
+        std::printf("\n          mean squared shift across the rays per level, mm^2, by start point / by line:");
+        for (std::size_t k = 0; k < br.shift_by_start.size() && k < br.shift_by_line.size(); ++k)
+          std::printf(" %.3g/%.3g", br.shift_by_start[k] * 1e6, br.shift_by_line[k] * 1e6);
+      }
       std::printf("\n          clustered by %s; %zu APLs at their rays' convergence point\n",
                   br.slid_to_convergence ? "line" : "start point", br.moved_to_convergence);
     }

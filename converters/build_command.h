@@ -20,6 +20,7 @@ struct BuildArgs {
   bool progress = false;             ///< --progress: show the bar even when stderr is not a terminal
   bool converge = true;              ///< --converge / --no-converge: rays as lines (AplBuildOptions)
   double apl_exponent = 0;           ///< --resolution-exponent
+  double smooth_rays = 0;            ///< --smooth: AplBuildOptions::map_smoothing_rays
   unsigned threads = 0;              ///< --threads (0: every core); the bundle does not depend on it
 };
 

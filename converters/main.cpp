@@ -130,6 +130,10 @@ const Command kCommands[] = {
                   "treat rays as lines: cluster them by where they come from and place each APL where its rays' "
                   "lines converge (least squares), when inside the luminaire (default); --no-converge: cluster "
                   "start points and place APLs at their box centres (the dissertation's rule)");
+       c.add_option("--smooth", g_build.smooth_rays,
+                    "flux-exact pull-push smoothing of sparse maps: texels with fewer rays than this are filled "
+                    "from coarser levels (default 0: off)")
+           ->check(CLI::Range(0.0, 1e6));
        c.add_option("--resolution-exponent", g_build.apl_exponent,
                     "the resolution rule's n^e, 2R^2 <= N/(rays-per-texel * n^e): 0 = the level's rays (default), "
                     "1 = one APL's")

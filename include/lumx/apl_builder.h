@@ -39,6 +39,7 @@
 #include <lumx/apl_set.h>
 #include <lumx/detail/point_kdtree.h>
 #include <lumx/line_fit.h>
+#include <lumx/sphere_map_smoothing.h>
 #include <lumx/rayset.h>
 
 #include <chrono>
@@ -67,6 +68,9 @@ struct AplBuildOptions {
   /// point, instead of clustering start points and placing APLs at their box centres (000 §4.3). On by
   /// default: a measured rayset's start points lie on the recording surface, not on the emitter.
   bool place_at_convergence = true;
+  /// Flux-exact pull-push smoothing of each map (sphere_map_smoothing.h) with this many rays per texel
+  /// as the threshold of a reliable texel; 0 = off. Needs power-of-two resolutions.
+  double map_smoothing_rays = 0;
   /// Called with the fraction done (0..1) and a phase name, at most a few hundred times.
   std::function<void(double, const char*)> progress;
 };
@@ -77,6 +81,8 @@ struct AplBuildReport {
   /// Step 1b: the mean squared shift across the rays (m², summed over levels) with seeds clustered by
   /// start point and by the point of their line nearest the convergence point; 0 when not compared.
   std::vector<double> shift_by_start, shift_by_line;  ///< per level
+  /// Step 1b: RMS distance of the lines from their convergence point / of the start points (≤ 0.85 to slide).
+  double line_convergence = 1;
   bool slid_to_convergence = false;       ///< step 1b chose the lines' points
   std::vector<int> map_resolution;        ///< per level
   std::vector<std::size_t> apl_count;     ///< per level (may be below the request for tiny raysets)
@@ -182,15 +188,20 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   };
   ClusterTree tree = build_cluster_tree(seed_pos, seed_flux, co);
   std::vector<std::vector<int>> cuts = make_cuts(tree);
-  // Step 1b: cluster the rays by the points of their lines nearest the convergence point c0 instead,
-  // unless that is much worse at some level by the measure step 6 minimises: the flux-weighted mean
-  // squared shift across the rays (LineFit) of the seeds moved to their APLs. Per level, mm², by start
-  // point / by line (lumx build prints them):
-  //   - separate emitters (tests/test_apl_builder.cpp): 4e-1 / 4.7e3 at 8 APLs: start points;
-  //   - Cyl1M_Faberge (recorded on a cylinder's caps): 0.38 / 0.16 at 8, 0.12 / 0.006 at 512: lines;
-  //   - the OSRAM LEDs and Cyl100k: 1.1–2.8× more by line at 64–512 APLs. The shift is only a proxy
-  //     for the irradiance error: by line, their 8-APL level is 25–35 % better at d = 0.5 (lumx eval),
-  //     and by start point it is worse than the single APL there. Hence a margin of 4.
+  // Step 1b: cluster the rays by the points of their lines nearest the rayset's convergence point c0
+  // instead of by start point, when both tests pass:
+  //   - the lines meet: their RMS distance from c0 across them is at most 0.85 × the start points' RMS
+  //     distance from c0. Rays leaving a flat Lambertian emitter give √3/2 ≈ 0.87 (position and direction
+  //     independent: the lines carry no more about the source than the start points), a narrow beam from
+  //     a flat aperture ≈ 1, separate emitters 0.89; rays recorded around a smaller emitter far less
+  //     (Cyl1M_Faberge 0.04, Cyl10k 0.11), the OSRAM LEDs 0.56–0.63, Cyl100k 0.82, a frosted bulb 0.71;
+  //   - at no level does it shift the rays (across them) more than 4× as much as start points do, by the
+  //     measure step 6 minimises (LineFit over the seeds moved to their APLs). This keeps separate emitters
+  //     apart (8 APLs on 8 emitters: 4e-1 mm² by start point against 5e3 mm² by line). Per level, mm², by
+  //     start point / by line: Cyl1M_Faberge 0.38 / 0.16 at 8 APLs, 0.12 / 0.006 at 512; the OSRAM LEDs
+  //     and Cyl100k 1.1–2.8× more by line at 64–512 APLs, yet by line their 8-APL level is 25–35 % better
+  //     at d = 0.5 (lumx eval), and by start point worse than the single APL there: the shift is a proxy.
+  // `lumx build` prints both figures.
   bool slide = false;
   glm::dvec3 c0 = set_bounds.center;
   if (options.place_at_convergence) {
@@ -222,7 +233,10 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
       }
       return per_level;
     };
-    if (glm::length(x - set_bounds.center) <= 1.001 * set_bounds.radius + 1e-9) {
+    const double across = all_lines.mean_line_distance2(x), start = all_lines.mean_start_distance2(x);
+    rep.line_convergence = start > 0 ? std::sqrt(across / start) : 1.0;
+    if (glm::length(x - set_bounds.center) <= 1.001 * set_bounds.radius + 1e-9 && start > 0 &&
+        across <= 0.85 * 0.85 * start) {
       std::vector<glm::vec3> slid(seed_pos.size());
       for (std::size_t i = 0; i < seed_pos.size(); ++i) slid[i] = slide_to_nearest(seed_pos[i], seed_dir[i], x);
       seed_orig = seed_pos;
@@ -302,6 +316,14 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
     texels[k] = 2 * R * R;
     sums[k].assign(std::size_t(texels[k]) * set.levels[k].apls.size(), 0);
   }
+  // Rays per texel, for the optional smoothing (its reliability threshold counts rays, not flux).
+  const bool smoothing = options.map_smoothing_rays > 0;
+  std::vector<std::vector<std::uint32_t>> counts(smoothing ? nl : 0);
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    const int R = set.levels[k].map_resolution;
+    if ((R & (R - 1)) != 0) throw std::invalid_argument("build_apl_set: map smoothing needs power-of-two resolutions");
+    counts[k].assign(sums[k].size(), 0);
+  }
   std::vector<LineFit> lines_of(options.place_at_convergence ? finest.size() : 0);  // per finest APL
   rays.rewind();
   std::uint64_t done = 0;
@@ -355,7 +377,9 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
       }
       for (std::size_t k = 0; k < nl; ++k) {
         const std::size_t apl = std::size_t(up[k][std::size_t(fine_of[i])]);
-        sums[k][apl * std::size_t(texels[k]) + std::size_t(texel_of_ray[i * nl + k])] += quanta[i];
+        const std::size_t t = apl * std::size_t(texels[k]) + std::size_t(texel_of_ray[i * nl + k]);
+        sums[k][t] += quanta[i];
+        if (smoothing && counts[k][t] < UINT32_MAX) ++counts[k][t];
       }
       if (options.place_at_convergence)
         lines_of[std::size_t(fine_of[i])].add(chunk.position(i), chunk.direction(i), chunk.flux[i]);
@@ -378,8 +402,23 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
         flux_units += double(s[t]);
       }
       apl.flux = glm::dvec3(flux_units * unit);
+      if (smoothing) {
+        // The prior: the parent's smoothed map (same resolution), else the bilinear shape.
+        const std::size_t T = std::size_t(texels[k]);
+        std::vector<double> f(s, s + T);
+        const std::uint32_t* c = counts[k].data() + a * T;
+        std::vector<double> prior;
+        if (k > 0 && set.levels[k - 1].map_resolution == R) {
+          const SphereMap& pm = set.levels[k - 1].apls[std::size_t(apl.parent)].map;
+          prior.assign(pm.values().begin(), pm.values().begin() + std::ptrdiff_t(T));
+        }
+        const std::vector<double> g = smooth_sparse_map(f, std::vector<std::uint32_t>(c, c + T), R,
+                                                        options.map_smoothing_rays, prior.empty() ? nullptr : &prior);
+        for (std::size_t t = 0; t < T; ++t) apl.map.values()[t] = float(g[t] * to_intensity);
+      }
     }
     std::vector<std::int64_t>().swap(sums[k]);
+    if (smoothing) std::vector<std::uint32_t>().swap(counts[k]);
   }
   set.bounds = set_bounds;
   if (options.place_at_convergence) {
