@@ -131,8 +131,8 @@ const Command kCommands[] = {
                   "lines converge (least squares), when inside the luminaire (default); --no-converge: cluster "
                   "start points and place APLs at their box centres (the dissertation's rule)");
        c.add_option("--smooth", g_build.smooth_rays,
-                    "flux-exact pull-push smoothing of sparse maps: texels with fewer rays than this are filled "
-                    "from coarser levels (default 0: off)")
+                    "flux-exact pull-push smoothing of sparse maps: a block of 2x2, 4x4, ... texels with fewer than 4T "
+                    "rays shares its light among its quarters like the parent APL's map (default 0: off)")
            ->check(CLI::Range(0.0, 1e6));
        c.add_option("--resolution-exponent", g_build.apl_exponent,
                     "the resolution rule's n^e, 2R^2 <= N/(rays-per-texel * n^e): 0 = the level's rays (default), "
