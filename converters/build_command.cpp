@@ -66,6 +66,7 @@ int run_build(const BuildArgs& a) {
       bo.progress = [&](double f, const char* phase) { bar.update(f, phase); };
       set = lumx::build_apl_set(*rays, bo, &br);
     }
+    const auto build_done = Clock::now();
     set.provenance["source"] = a.rays;
     std::printf("levels:   ");
     for (std::size_t k = 0; k < set.levels.size(); ++k)
@@ -95,6 +96,7 @@ int run_build(const BuildArgs& a) {
       report = lumx::evaluate_apl_errors(set, *rays, eo);
       lumx::store_error_tables(set, report);
     }
+    const auto evaluated = Clock::now();
 
     // The rays' far field as IES and EULUMDAT, shipped inside the bundle.
     lumx::BundleWriteOptions wo;
@@ -114,11 +116,15 @@ int run_build(const BuildArgs& a) {
                       ? ("rays in W at " + std::to_string(grid.luminous_efficacy_lm_per_w) + " lm/W").c_str()
                       : "rays in lm");
     }
+    const auto far_done = Clock::now();
     lumx::write_bundle(a.out, set, nullptr, wo);
     const lumx::BundleReader written(a.out);
-    std::printf("bundle:   %s, %llu bytes, written in %.2f s\n", a.out.c_str(),
-                (unsigned long long)written.manifest().total_bytes(),
-                std::chrono::duration<double>(Clock::now() - start).count());
+    const auto seconds = [](Clock::time_point from, Clock::time_point to) {
+      return std::chrono::duration<double>(to - from).count();
+    };
+    std::printf("bundle:   %s, %llu bytes; evaluation %.2f s, far field %.2f s, writing %.2f s; %.2f s in all\n",
+                a.out.c_str(), (unsigned long long)written.manifest().total_bytes(), seconds(build_done, evaluated),
+                seconds(evaluated, far_done), seconds(far_done, Clock::now()), seconds(start, Clock::now()));
     if (evaluate) std::cout << "\n" << format_error_table(report, a.out, a.rays, set.quantity);
     return 0;
   });
