@@ -74,8 +74,10 @@ int run_build(const BuildArgs& a) {
     std::printf("\n          from %llu seeds: seeds %.2f s, tree %.2f s, assignment %.2f s\n",
                 (unsigned long long)br.seeds, br.seconds_seed, br.seconds_tree, br.seconds_assign);
     if (a.converge) {
-      std::printf("lines:    RMS distance from their convergence point / start points' %.3f (<= 0.85 to cluster by line)",
-                  br.line_convergence);
+      std::printf("lines:    RMS distance from their convergence point / start points' %.3f; with directions "
+                  "shuffled %.3f (ratio %.3f)",
+                  br.line_convergence, br.line_convergence_shuffled,
+                  br.line_convergence / std::max(1e-300, br.line_convergence_shuffled));
       if (!br.shift_by_start.empty()) {
         std::printf("\n          mean squared shift across the rays per level, mm^2, by start point / by line:");
         for (std::size_t k = 0; k < br.shift_by_start.size() && k < br.shift_by_line.size(); ++k)

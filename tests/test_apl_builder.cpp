@@ -373,6 +373,7 @@ TEST(AplBuilder, ConvergencePlacementFindsAnEnclosedEmitter) {
   AplBuildReport report;
   const AplSet moved = build_apl_set(rays, o, &report);
   EXPECT_EQ(report.moved_to_convergence, 9u);
+  EXPECT_FALSE(report.slid_to_convergence);  // every line meets in one point: clustering by line degenerates
   for (const Apl& a : moved.levels[1].apls) EXPECT_LT(glm::length(a.position), 1e-3f);  // the emitter
   EXPECT_TRUE(check_apl_set(moved).empty());
   const AplErrorReport converged = evaluate_apl_errors(moved, rays, eo);
@@ -434,7 +435,7 @@ TEST(LineFit, NearestPointEigenSolveAndShiftSums) {
   EXPECT_EQ(bad.weight, 0.0);
 }
 
-TEST(AplBuilder, SmoothingKeepsEveryApLsFluxAndTheLevelsFarField) {
+TEST(AplBuilder, SmoothingKeepsEveryAplsFluxAndReducesItsNoise) {
   MemoryRaySource rays = emitter_rays(8, 3000, 17);
   AplBuildOptions o;
   o.level_counts = {1, 8, 64};
@@ -478,4 +479,137 @@ TEST(AplBuilder, SmoothingKeepsEveryApLsFluxAndTheLevelsFarField) {
                  build_apl_set(rays, bad);
                }()),
                std::invalid_argument);
+}
+
+namespace {
+
+/// `n` rays from a ball of radius `source_m` at `centre` (uniform in volume, isotropic), recorded where
+/// they leave a sphere of radius `record_m` about `centre`; `source_m` = 0 is a point source.
+MemoryRaySource enclosed_rays(int n, double source_m, double record_m, glm::dvec3 centre, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  RayChunk c;
+  for (int i = 0; i < n; ++i) {
+    glm::dvec3 q(g(rng), g(rng), g(rng));
+    q = glm::normalize(q) * source_m * std::cbrt(u(rng));
+    const glm::dvec3 w = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
+    // Exit of q + t w from the sphere |x| = record_m: t = −q·w + √((q·w)² − |q|² + r²).
+    const double b = glm::dot(q, w), t = -b + std::sqrt(b * b - glm::dot(q, q) + record_m * record_m);
+    c.push_back(glm::vec3(centre + q + t * w), glm::vec3(w), 1.0f);
+  }
+  return MemoryRaySource(std::move(c), RaysetInfo{});
+}
+
+}  // namespace
+
+TEST(AplBuilder, ClustersByLineOnlyWhenTheLinesMeet) {
+  AplBuildOptions o;
+  o.level_counts = {1, 8, 64};
+  o.map_resolution = 16;
+  {  // a 2 mm source recorded on a 20 mm sphere: by line, and no APL left without light
+    MemoryRaySource rays = enclosed_rays(60000, 0.002, 0.02, {0.3, 0.2, 0.1}, 1);
+    AplBuildReport r1, r2;
+    o.threads = 1;
+    const AplSet a = build_apl_set(rays, o, &r1);
+    o.threads = 2;
+    o.chunk_rays = 7000;
+    const AplSet b = build_apl_set(rays, o, &r2);
+    EXPECT_TRUE(r1.slid_to_convergence);
+    EXPECT_LT(r1.line_convergence, 0.5 * r1.line_convergence_shuffled);
+    for (const Apl& apl : a.levels.back().apls) EXPECT_GT(apl.flux.x, 0.0);
+    // Every APL ends up near the source (within its 2 mm), not on the recording sphere.
+    for (const Apl& apl : a.levels.back().apls) EXPECT_LT(glm::length(glm::dvec3(apl.position) - glm::dvec3(0.3, 0.2, 0.1)), 0.004);
+    // Deterministic on this path too: 1 and 2 threads, different chunks, the same set.
+    ASSERT_EQ(a.levels.size(), b.levels.size());
+    for (std::size_t k = 0; k < a.levels.size(); ++k)
+      for (std::size_t i = 0; i < a.levels[k].size(); ++i) {
+        EXPECT_EQ(a.levels[k].apls[i].position, b.levels[k].apls[i].position);
+        EXPECT_EQ(a.levels[k].apls[i].map.values(), b.levels[k].apls[i].map.values());
+      }
+    o.threads = 1;
+    o.chunk_rays = 1 << 16;
+  }
+  {  // an ideal point source away from the origin: its lines meet in one point, so start points
+    MemoryRaySource rays = enclosed_rays(60000, 0.0, 0.05, {0.3, 0.2, 0.1}, 2);
+    AplBuildReport r;
+    const AplSet set = build_apl_set(rays, o, &r);
+    EXPECT_FALSE(r.slid_to_convergence);
+    for (const Apl& apl : set.levels.back().apls) EXPECT_GT(apl.flux.x, 0.0);
+    for (const Apl& apl : set.levels.back().apls) EXPECT_LT(glm::length(glm::dvec3(apl.position) - glm::dvec3(0.3, 0.2, 0.1)), 1e-4);
+  }
+  {  // flat emitters whose directions do not depend on position (uniform hemisphere and batwing, wider
+     // than Lambertian): start points, whatever their plain ratio says
+    for (int batwing = 0; batwing < 2; ++batwing) {
+      std::mt19937 rng(3 + unsigned(batwing));
+      std::uniform_real_distribution<float> u(0.0f, 1.0f);
+      RayChunk c;
+      while (c.size() < 60000) {
+        const float ct = u(rng), st = std::sqrt(1 - ct * ct), az = float(2 * kPi) * u(rng);
+        if (batwing && u(rng) > st * st) continue;  // ∝ sin²θ on top of uniform
+        c.push_back({0.1f * u(rng) - 0.05f, 0.1f * u(rng) - 0.05f, 0.0f}, {st * std::cos(az), st * std::sin(az), -ct}, 1.0f);
+      }
+      MemoryRaySource rays(std::move(c), RaysetInfo{});
+      AplBuildReport r;
+      build_apl_set(rays, o, &r);
+      EXPECT_FALSE(r.slid_to_convergence) << batwing << " " << r.line_convergence << " " << r.line_convergence_shuffled;
+      EXPECT_LT(r.line_convergence, 0.85) << batwing;  // the plain ratio alone would have let them slide
+      EXPECT_NEAR(r.line_convergence / r.line_convergence_shuffled, 1.0, 0.02) << batwing;
+    }
+  }
+  {  // separate emitters: start points (their lines do not meet)
+    MemoryRaySource rays = emitter_rays(8, 3000, 5);
+    AplBuildReport r;
+    build_apl_set(rays, o, &r);
+    EXPECT_FALSE(r.slid_to_convergence);
+  }
+}
+
+TEST(AplBuilder, MillionsOfRaysInOneTexelDoNotOverflow) {
+  // 9 M rays of equal flux in one direction from one point: 9 M × the largest flux in one texel, past
+  // the 2^23 that a fixed 2^-40 unit would allow in 64 bits. Rays are generated chunk by chunk.
+  struct Beam : RaySource {
+    RaysetInfo info_;
+    std::uint64_t n = 9000000, at = 0;
+    Beam() { info_.ray_count = n; }
+    const RaysetInfo& info() const override { return info_; }
+    bool next(RayChunk& out, std::size_t max_rays) override {
+      out.clear();
+      for (; at < n && out.size() < max_rays; ++at) out.push_back({0, 0, 0}, {0, 0, -1}, 0.5f);
+      return !out.empty();
+    }
+    void rewind() override { at = 0; }
+  } beam;
+  AplBuildOptions o;
+  o.level_counts = {1};
+  o.seed_rays = 1000;
+  o.map_resolution = 8;
+  const AplSet set = build_apl_set(beam, o);
+  EXPECT_TRUE(check_apl_set(set).empty());
+  EXPECT_NEAR(set.levels[0].apls[0].flux.x, 4.5e6, 1e-9 * 4.5e6);
+  EXPECT_NEAR(set.levels[0].apls[0].map.integral().x, 4.5e6, 1e-6 * 4.5e6);
+}
+
+TEST(LineFit, ANearlyParallelBundleTakesItsAxisCoordinateFromTheAnchor) {
+  // Lines within 0.003 rad of +z through points near the z axis: the mean projector's eigenvalue along
+  // z is ~1e-5. Below the threshold (1e-3) the z coordinate is the anchor's; with a threshold below the
+  // eigenvalue the lines decide it (their waist, near z = 0).
+  LineFit fit;
+  std::mt19937 rng(8);
+  std::normal_distribution<float> g;
+  for (int i = 0; i < 1000; ++i) {
+    const glm::vec3 w = glm::normalize(glm::vec3(0.003f * g(rng), 0.003f * g(rng), 1.0f));
+    const glm::vec3 p = glm::vec3(0.001f * g(rng), 0.001f * g(rng), 0.0f) + 0.5f * g(rng) * w;
+    fit.add(p, w, 1.0f);
+  }
+  glm::dvec3 l;
+  glm::dmat3 V;
+  LineFit::symmetric_eigen(fit.A / fit.weight, l, V);
+  EXPECT_LT(std::min({l.x, l.y, l.z}), 1e-4);
+  EXPECT_GT(std::min({l.x, l.y, l.z}), 1e-6);
+  const glm::dvec3 anchored = fit.solve({0, 0, 7}, 1e-3);
+  EXPECT_NEAR(anchored.z, 7.0, 1e-6);
+  EXPECT_NEAR(anchored.x, 0.0, 1e-3);
+  const glm::dvec3 free = fit.solve({0, 0, 7}, 1e-7);
+  EXPECT_LT(std::abs(free.z), 0.5);
 }

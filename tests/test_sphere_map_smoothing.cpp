@@ -105,16 +105,124 @@ TEST(SphereMapSmoothing, ReducesTheNoiseOfASparseHistogram) {
   EXPECT_LT(with_prior, smooth) << with_prior;
 }
 
-TEST(SphereMapSmoothing, TooFewRaysAnywhereTakeThePriorsShape) {
-  // 5 rays over 2 · 8² texels, threshold 4: no node is dense (the map would need 2·4 rays to split its
-  // hemispheres by the data), so the output is the total flux shaped exactly like the prior.
+TEST(SphereMapSmoothing, TooFewRaysTakeThePriorsShapeWithinEachHemisphere) {
+  // 5 rays over 2 · 8² texels, threshold 4: no node below the top is dense, so each hemisphere keeps the
+  // flux its rays brought (the data decide the hemispheres) shaped exactly like the prior inside it.
   const int R = 8;
   const Histogram h = dipole_histogram(R, 5, 3);
   std::vector<double> prior(h.flux.size());
   for (std::size_t i = 0; i < prior.size(); ++i) prior[i] = 1.0 + double(i % 7);
   const std::vector<double> out = smooth_sparse_map(h.flux, h.rays, R, 4, &prior);
-  const double k = sum(h.flux) / sum(prior);
-  for (std::size_t i = 0; i < out.size(); ++i) EXPECT_NEAR(out[i], k * prior[i], 1e-12) << i;
+  for (int half = 0; half < 2; ++half) {
+    double data = 0, shape = 0;
+    for (int y = 0; y < R; ++y)
+      for (int x = half * R; x < (half + 1) * R; ++x) {
+        data += h.flux[std::size_t(y) * std::size_t(2 * R) + std::size_t(x)];
+        shape += prior[std::size_t(y) * std::size_t(2 * R) + std::size_t(x)];
+      }
+    for (int y = 0; y < R; ++y)
+      for (int x = half * R; x < (half + 1) * R; ++x) {
+        const std::size_t t = std::size_t(y) * std::size_t(2 * R) + std::size_t(x);
+        EXPECT_NEAR(out[t], data / shape * prior[t], 1e-12) << x << " " << y;
+      }
+  }
+}
+
+TEST(SphereMapSmoothing, AFewDownwardRaysStayDownward) {
+  // A downlight's 10 rays, all below the horizon (right square), threshold far above: no light may
+  // reach the upper hemisphere, with or without a prior that has light there.
+  const int R = 8;
+  const std::size_t T = std::size_t(2 * R * R);
+  std::vector<double> flux(T, 0.0);
+  std::vector<std::uint32_t> rays(T, 0);
+  for (int i = 0; i < 10; ++i) {
+    const std::size_t t = std::size_t(i % R) * std::size_t(2 * R) + std::size_t(R + (3 * i) % R);
+    flux[t] += 1.0;
+    ++rays[t];
+  }
+  const std::vector<double> uniform(T, 1.0);
+  for (const std::vector<double>* prior : {static_cast<const std::vector<double>*>(nullptr), &uniform}) {
+    const std::vector<double> out = smooth_sparse_map(flux, rays, R, 1000, prior);
+    double up = 0, down = 0;
+    for (int y = 0; y < R; ++y)
+      for (int x = 0; x < 2 * R; ++x) (x < R ? up : down) += out[std::size_t(y) * std::size_t(2 * R) + std::size_t(x)];
+    EXPECT_EQ(up, 0.0);
+    EXPECT_NEAR(down, 10.0, 1e-12);
+  }
+}
+
+TEST(SphereMapSmoothing, WithoutAPriorTheShapeIsTheBilinearUpsampling) {
+  // R = 8; rays only in the upper square's left half (x < 4), one per texel: 32 rays. Threshold 4, so a
+  // node splits by the data from 16 rays up. The square (32) and its 4 × 4 quadrants (16, 0) split by the
+  // data: the right half stays exactly dark. The 2 × 2 nodes (4 rays) are sparse: their texels take the
+  // bilinear upsampling of the 2 × 2 level, flat (4, 4) away from the dark edge and ramping down next to
+  // it: texel columns 0 and 1 equal, column 3 darker than column 2.
+  const int R = 8;
+  const std::size_t T = std::size_t(2 * R * R), W = std::size_t(2 * R);
+  std::vector<double> flux(T, 0.0);
+  std::vector<std::uint32_t> rays(T, 0);
+  for (int y = 0; y < R; ++y)
+    for (int x = 0; x < R / 2; ++x) {
+      flux[std::size_t(y) * W + std::size_t(x)] = 1.0;
+      rays[std::size_t(y) * W + std::size_t(x)] = 1;
+    }
+  const std::vector<double> out = smooth_sparse_map(flux, rays, R, 4);
+  double sum = 0;
+  for (int y = 0; y < R; ++y) {
+    for (int x = 0; x < R; ++x) sum += out[std::size_t(y) * W + std::size_t(x)];
+    for (int x = R / 2; x < R; ++x) EXPECT_EQ(out[std::size_t(y) * W + std::size_t(x)], 0.0) << x << " " << y;
+    const double* row = out.data() + std::size_t(y) * W;
+    EXPECT_NEAR(row[0], row[1], 1e-12) << y;
+    EXPECT_GT(row[2], row[3] + 0.05) << y;
+    EXPECT_GT(row[3], 0.0) << y;
+  }
+  EXPECT_NEAR(sum, 32.0, 1e-12);
+}
+
+TEST(SphereMapSmoothing, ADarkPriorFallsBackToTheSmoothShape) {
+  // A prior with no light in the upper square, sparse data there: the upper square's flux must still be
+  // placed (by the bilinear shape), not lost or left to a 0/0.
+  const int R = 8;
+  const Histogram h = dipole_histogram(R, 40, 9);
+  std::vector<double> prior(h.flux.size(), 0.0);
+  for (int y = 0; y < R; ++y)
+    for (int x = R; x < 2 * R; ++x) prior[std::size_t(y) * std::size_t(2 * R) + std::size_t(x)] = 1.0;
+  const std::vector<double> out = smooth_sparse_map(h.flux, h.rays, R, 100, &prior);
+  double up_in = 0, up_out = 0;
+  for (int y = 0; y < R; ++y)
+    for (int x = 0; x < R; ++x) {
+      up_in += h.flux[std::size_t(y) * std::size_t(2 * R) + std::size_t(x)];
+      up_out += out[std::size_t(y) * std::size_t(2 * R) + std::size_t(x)];
+      EXPECT_TRUE(std::isfinite(out[std::size_t(y) * std::size_t(2 * R) + std::size_t(x)]));
+    }
+  EXPECT_GT(up_in, 0.0);
+  EXPECT_NEAR(up_out, up_in, 1e-12);
+  // And the fallback has a shape: upper-square quadrants (0,0) and (1,1) hold 12 rays each, (1,0) and
+  // (0,1) none; threshold 4, so the square splits by the data (24 ≥ 16) and the quadrants (12 < 16) by
+  // the shape. With the prior dark there, texels next to the dark quadrants get less than those far
+  // from them (an equal split would make the quadrant flat).
+  {
+    const std::size_t W = std::size_t(2 * R);
+    std::vector<double> f(h.flux.size(), 0.0);
+    std::vector<std::uint32_t> c(h.flux.size(), 0);
+    for (int i = 0; i < 12; ++i) {
+      const int x = i % 4, y = (i / 4) % 4;
+      f[std::size_t(y) * W + std::size_t(x)] += 1;
+      ++c[std::size_t(y) * W + std::size_t(x)];
+      f[std::size_t(y + 4) * W + std::size_t(x + 4)] += 1;
+      ++c[std::size_t(y + 4) * W + std::size_t(x + 4)];
+    }
+    const std::vector<double> o = smooth_sparse_map(f, c, R, 4, &prior);
+    EXPECT_GT(o[0], o[3] + 0.01);           // (0,0) far from the dark quadrant (1,0); (3,0) next to it
+    EXPECT_GT(o[0], o[3 * W] + 0.01);       // likewise (0,3) next to the dark quadrant (0,1)
+    EXPECT_EQ(o[4], 0.0);                   // the dark quadrants stay dark
+  }
+  // Non-finite and negative prior values count as dark.
+  std::vector<double> bad = prior;
+  bad[0] = INFINITY;
+  bad[1] = -5;
+  bad[2] = NAN;
+  for (double v : smooth_sparse_map(h.flux, h.rays, R, 100, &bad)) EXPECT_TRUE(std::isfinite(v));
 }
 
 TEST(SphereMapSmoothing, RefusesBadArguments) {

@@ -3,11 +3,12 @@
 //   1. Seeds: `seed_rays` rays spread evenly through the file (every (N/S)-th ray with flux > 0; files
 //      are often sorted by position or emitter, so "the first S" would seed one corner of the source).
 //      1b. Rays as lines (AplBuildOptions::place_at_convergence, the default): a ray's start point is
-//      only where it was recorded, anywhere along its line. The same pass fits the rayset's convergence
-//      point c0 (LineFit: least squares over every ray's line); when c0 is inside the luminaire's bound,
-//      each ray is represented by the point of its line nearest c0, so rays recorded on a surface around
-//      a smaller emitter are clustered by where they come from (Cyl1M_Faberge's rays lie on the caps of
-//      a cylinder but pass within ~1 mm of its centre).
+//      only where it was recorded, anywhere along its line. The seeds' convergence point c0 (LineFit:
+//      least squares over their lines) is fitted; when it is inside the luminaire's bound and three tests
+//      pass (the lines meet, clustering by line does not shift the rays much more, the lines do not meet
+//      in one point; see the code), each ray is represented by the point of its line nearest c0, so rays
+//      recorded on a surface around a smaller emitter are clustered by where they come from
+//      (Cyl1M_Faberge's rays lie on the caps of a cylinder but pass within ~1 mm of its centre).
 //   2. Tree: agglomerative clustering of the seeds' points with eq. 4.1 (apl_clustering.h).
 //   3. Levels: cuts of the tree with 1, 8, 64, ... clusters; an APL sits at the centre of its seeds'
 //      bounding box (000 §4.3); parents are the enclosing clusters of the previous cut.
@@ -19,8 +20,8 @@
 //      direction (the ray is "moved" to the APL, keeping its direction). Sums are kept in 64-bit fixed
 //      point, so they do not depend on the order rays arrive in, and converted to float at the end.
 //   6. With place_at_convergence, each APL then moves to the least-squares point of its own rays' lines
-//      (regularised toward its parent along directions the map cannot resolve; see the code), which
-//      minimises the flux-weighted squared shift across each ray that step 5 implies.
+//      (along directions the map cannot resolve, its parent's coordinate: a truncated solve; see the
+//      code), which minimises the flux-weighted squared shift across each ray that step 5 implies.
 //
 // Map resolution per level (when not fixed by the caller): a histogram of m rays over T texels has a
 // relative noise of about 1/√(m/T) per texel. A shading point sums every APL of the level, so in the mid
@@ -46,6 +47,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -78,11 +80,13 @@ struct AplBuildOptions {
 struct AplBuildReport {
   std::uint64_t rays = 0, seeds = 0, zero_flux_rays = 0;
   std::size_t moved_to_convergence = 0;   ///< APLs placed at their rays' convergence point
-  /// Step 1b: the mean squared shift across the rays (m², summed over levels) with seeds clustered by
-  /// start point and by the point of their line nearest the convergence point; 0 when not compared.
-  std::vector<double> shift_by_start, shift_by_line;  ///< per level
-  /// Step 1b: RMS distance of the lines from their convergence point / of the start points (≤ 0.85 to slide).
-  double line_convergence = 1;
+  /// Step 1b: per level, the seeds' mean squared shift across the rays (m²) when clustered by start point
+  /// and by the point of their line nearest the convergence point (each cluster's point from a truncated
+  /// solve anchored on its own box centre); empty when not compared.
+  std::vector<double> shift_by_start, shift_by_line;
+  /// Step 1b: RMS distance of the seeds' lines from their convergence point / of their start points, and
+  /// the same with the directions shuffled among the seeds (slide when the first ≤ 0.9 × the second).
+  double line_convergence = 1, line_convergence_shuffled = 1;
   bool slid_to_convergence = false;       ///< step 1b chose the lines' points
   std::vector<int> map_resolution;        ///< per level
   std::vector<std::size_t> apl_count;     ///< per level (may be below the request for tiny raysets)
@@ -116,6 +120,9 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   if (options.seed_rays < 1) throw std::invalid_argument("build_apl_set: seed_rays must be ≥ 1");
   if (options.map_resolution < 0 || options.map_resolution > sphere_map::kMaxResolution)
     throw std::invalid_argument("build_apl_set: map_resolution outside [0, 4096]");
+  if (options.min_resolution < 1 || options.max_resolution < options.min_resolution ||
+      options.max_resolution > sphere_map::kMaxResolution)
+    throw std::invalid_argument("build_apl_set: need 1 ≤ min_resolution ≤ max_resolution ≤ 4096");
   AplBuildReport local;
   AplBuildReport& rep = report ? *report : local;
   rep = AplBuildReport{};
@@ -140,7 +147,6 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   seed_pos.reserve(std::size_t(want));
   seed_flux.reserve(std::size_t(want));
   if (options.place_at_convergence) seed_dir.reserve(std::size_t(want));
-  LineFit all_lines;  // every ray's line, for the convergence point (summed in file order: deterministic)
   rays.rewind();
   std::uint64_t index = 0;
   float max_flux = 0;  // for the fixed-point unit of step 5, gathered in this pass over every ray
@@ -152,7 +158,6 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
       if (!(f >= 0) || !std::isfinite(f) || !std::isfinite(p.x + p.y + p.z) || !std::isfinite(w.x + w.y + w.z) ||
           std::abs(glm::dot(w, w) - 1.0f) > 1e-3f)
         throw std::invalid_argument(bad_ray_message(index + i));
-      if (options.place_at_convergence) all_lines.add(p, w, f);
     }
     for (std::size_t i = 0; i < chunk.size(); ++i, ++index) {
       // Ray `index` is a seed when ⌊(index+1)·S/N⌋ > ⌊index·S/N⌋: exactly S seeds, evenly spaced.
@@ -188,24 +193,33 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   };
   ClusterTree tree = build_cluster_tree(seed_pos, seed_flux, co);
   std::vector<std::vector<int>> cuts = make_cuts(tree);
-  // Step 1b: cluster the rays by the points of their lines nearest the rayset's convergence point c0
-  // instead of by start point, when both tests pass:
-  //   - the lines meet: their RMS distance from c0 across them is at most 0.85 × the start points' RMS
-  //     distance from c0. Rays leaving a flat Lambertian emitter give √3/2 ≈ 0.87 (position and direction
-  //     independent: the lines carry no more about the source than the start points), a narrow beam from
-  //     a flat aperture ≈ 1, separate emitters 0.89; rays recorded around a smaller emitter far less
-  //     (Cyl1M_Faberge 0.04, Cyl10k 0.11), the OSRAM LEDs 0.56–0.63, Cyl100k 0.82, a frosted bulb 0.71;
+  // Step 1b: cluster the rays by the points of their lines nearest the seeds' convergence point c0
+  // instead of by start point, when all of these hold:
+  //   - the lines meet: their RMS distance from c0 (across them) relative to the start points' RMS
+  //     distance from it is below the same ratio with the directions shuffled among the seeds (start
+  //     point and direction made independent), by more than chance: a factor min(0.97, 1 − 10/√n) for n
+  //     seeds. A flat emitter of any angular distribution, a beam from an aperture or identical emitters
+  //     give ≈ 1 (their lines say no more about where the light comes from than the start points); rays
+  //     recorded around a smaller emitter far less (Cyl1M_Faberge 0.08, Cyl10k 0.15, the OSRAM LEDs,
+  //     recorded around the package, 0.64–0.72), the emitting surface of Cyl100k 0.962 (it slides: by
+  //     line its 8-APL level is 9.6 % off at d = 0.5 against 13.1 % by start point, its 512-APL level
+  //     4.1 against 4.0 %);
   //   - at no level does it shift the rays (across them) more than 4× as much as start points do, by the
-  //     measure step 6 minimises (LineFit over the seeds moved to their APLs). This keeps separate emitters
-  //     apart (8 APLs on 8 emitters: 4e-1 mm² by start point against 5e3 mm² by line). Per level, mm², by
-  //     start point / by line: Cyl1M_Faberge 0.38 / 0.16 at 8 APLs, 0.12 / 0.006 at 512; the OSRAM LEDs
-  //     and Cyl100k 1.1–2.8× more by line at 64–512 APLs, yet by line their 8-APL level is 25–35 % better
-  //     at d = 0.5 (lumx eval), and by start point worse than the single APL there: the shift is a proxy.
-  // `lumx build` prints both figures.
+  //     measure step 6 minimises (LineFit over the seeds moved to their APLs). This keeps emitters that
+  //     merely point away from a common centre apart. Per level, mm², by start point / by line:
+  //     Cyl1M_Faberge 0.38 / 0.16 at 8 APLs, 0.12 / 0.006 at 512; the OSRAM LEDs 1.1–2.3× more by line at
+  //     64–512 APLs, yet by line their 8-APL level is 25–35 % better at d = 0.5 (lumx eval): the shift
+  //     is a proxy;
+  //   - the lines do not all meet in one point (the slid seeds' box is not below 1e-4 of the seeds'):
+  //     then every clustering by line is degenerate, while start points still split the light by
+  //     direction, and step 6 puts every APL at that point anyway.
+  // `lumx build` prints the figures.
   bool slide = false;
   glm::dvec3 c0 = set_bounds.center;
   if (options.place_at_convergence) {
-    const glm::dvec3 x = all_lines.solve(set_bounds.center, 1e-3);
+    LineFit seed_lines;
+    for (std::size_t i = 0; i < seed_pos.size(); ++i) seed_lines.add(seed_pos[i], seed_dir[i], seed_flux[i]);
+    const glm::dvec3 x = seed_lines.solve(set_bounds.center, 1e-3);
     auto shift_cost = [&](const ClusterTree& t, const std::vector<std::vector<int>>& c) {
       std::vector<double> per_level;
       std::vector<int> label(t.size());
@@ -233,18 +247,39 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
       }
       return per_level;
     };
-    const double across = all_lines.mean_line_distance2(x), start = all_lines.mean_start_distance2(x);
+    const double across = seed_lines.mean_line_distance2(x), start = seed_lines.mean_start_distance2(x);
     rep.line_convergence = start > 0 ? std::sqrt(across / start) : 1.0;
+    // The same with directions shuffled: seed i paired with direction π(i) = i·P mod n, P coprime to n.
+    LineFit shuffled;
+    {
+      const std::size_t n = seed_pos.size();
+      std::uint64_t P = 2654435761u % std::max<std::size_t>(n, 1);
+      while (n > 1 && std::gcd(P, std::uint64_t(n)) != 1) ++P;
+      for (std::size_t i = 0; i < n; ++i)
+        shuffled.add(seed_pos[i], seed_dir[std::size_t((std::uint64_t(i) * P) % n)], seed_flux[i]);
+      const glm::dvec3 xs = shuffled.solve(set_bounds.center, 1e-3);
+      const double a2 = shuffled.mean_line_distance2(xs), s2 = shuffled.mean_start_distance2(xs);
+      rep.line_convergence_shuffled = s2 > 0 ? std::sqrt(a2 / s2) : 1.0;
+    }
+    // Shuffled, the ratio scatters by about 1/√n around its mean (measured: flat emitters of 100 k seeds
+    // 1.000–1.003 of it), so a departure of 10/√n, and at least 3 %, is correlation, not chance.
+    const double significant = std::min(0.97, 1.0 - 10.0 / std::sqrt(double(seed_pos.size())));
     if (glm::length(x - set_bounds.center) <= 1.001 * set_bounds.radius + 1e-9 && start > 0 &&
-        across <= 0.85 * 0.85 * start) {
+        rep.line_convergence <= significant * rep.line_convergence_shuffled) {
       std::vector<glm::vec3> slid(seed_pos.size());
-      for (std::size_t i = 0; i < seed_pos.size(); ++i) slid[i] = slide_to_nearest(seed_pos[i], seed_dir[i], x);
+      glm::dvec3 slid_lo(slide_to_nearest(seed_pos[0], seed_dir[0], x)), slid_hi = slid_lo;
+      for (std::size_t i = 0; i < seed_pos.size(); ++i) {
+        slid[i] = slide_to_nearest(seed_pos[i], seed_dir[i], x);
+        slid_lo = glm::min(slid_lo, glm::dvec3(slid[i]));
+        slid_hi = glm::max(slid_hi, glm::dvec3(slid[i]));
+      }
       seed_orig = seed_pos;
       ClusterTree slid_tree = build_cluster_tree(slid, seed_flux, co);
       std::vector<std::vector<int>> slid_cuts = make_cuts(slid_tree);
       rep.shift_by_start = shift_cost(tree, cuts);
       rep.shift_by_line = shift_cost(slid_tree, slid_cuts);
-      bool better = rep.shift_by_line.size() == rep.shift_by_start.size();
+      bool better = rep.shift_by_line.size() == rep.shift_by_start.size() &&
+                    glm::length(slid_hi - slid_lo) >= 1e-4 * 2.0 * set_bounds.radius;
       for (std::size_t k = 0; better && k < rep.shift_by_line.size(); ++k)
         better = rep.shift_by_line[k] <= 4 * rep.shift_by_start[k];
       if (better) {
@@ -307,8 +342,9 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
 
   // ---- 4.–5. assignment and maps, in 64-bit fixed point (order-independent sums)
   if (!(max_flux > 0)) throw std::invalid_argument("build_apl_set: no ray carries flux");
-  // One unit = max_flux · 2^-40: 10^10 rays of the largest flux still fit in 2^63.
-  const double unit = double(max_flux) * std::ldexp(1.0, -40);
+  // One unit = max_flux · max(2^-40, N · 2^-62): all N rays at the largest flux, in one texel, still sum
+  // below 2^62, and a ray's flux is kept to 2^-40 of the largest one (finer only for N < 2^22).
+  const double unit = double(max_flux) * std::max(std::ldexp(1.0, -40), double(total) * std::ldexp(1.0, -62));
   std::vector<std::vector<std::int64_t>> sums(nl);
   std::vector<int> texels(nl);
   for (std::size_t k = 0; k < nl; ++k) {
@@ -403,14 +439,15 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
       }
       apl.flux = glm::dvec3(flux_units * unit);
       if (smoothing) {
-        // The prior: the parent's smoothed map (same resolution), else the bilinear shape.
+        // The prior: the parent's smoothed map at this resolution; else (a coarser parent) the bilinear shape.
         const std::size_t T = std::size_t(texels[k]);
         std::vector<double> f(s, s + T);
         const std::uint32_t* c = counts[k].data() + a * T;
         std::vector<double> prior;
-        if (k > 0 && set.levels[k - 1].map_resolution == R) {
-          const SphereMap& pm = set.levels[k - 1].apls[std::size_t(apl.parent)].map;
-          prior.assign(pm.values().begin(), pm.values().begin() + std::ptrdiff_t(T));
+        if (k > 0) {  // the parent's map, box-downsampled to R when it is finer (flux-exact)
+          SphereMap pm = set.levels[k - 1].apls[std::size_t(apl.parent)].map;
+          while (pm.resolution() > R && pm.resolution() % 2 == 0) pm = pm.downsampled();
+          if (pm.resolution() == R) prior.assign(pm.values().begin(), pm.values().begin() + std::ptrdiff_t(T));
         }
         const std::vector<double> g = smooth_sparse_map(f, std::vector<std::uint32_t>(c, c + T), R,
                                                         options.map_smoothing_rays, prior.empty() ? nullptr : &prior);

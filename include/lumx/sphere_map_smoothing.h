@@ -18,10 +18,11 @@
 // a sparse region is spread over the smallest pyramid node holding 4·min_rays of its rays. Why a prior:
 // the bilinear shape blurs; when many APLs overlap (far away, or APLs that share one small emitter) their
 // blurred maps sum to a blurred level. With the parent's map as the shape, where all children of a parent
-// are sparse their smoothed maps sum back to the parent's map, so overlapping APLs lose nothing.
+// are sparse their smoothed maps sum back to the parent's map (overlapping APLs lose less; the bias
+// that remains where siblings differ in density is measured in docs/apl_sets.md).
 // Interpolation stays inside a hemisphere's square (clamped at its border, the equator); the two
-// hemispheres split the map's flux by the data when the map holds 2·min_rays rays, else by the prior (or
-// by area).
+// hemispheres split the map's flux by the data whenever it has a ray (a downlight's few rays must not
+// light the ceiling), else by the prior or by area.
 #pragma once
 
 #include <lumx/version.h>
@@ -66,7 +67,10 @@ inline std::vector<double> smooth_sparse_map(const std::vector<double>& flux, co
         const std::size_t t = std::size_t(y) * W + std::size_t(h * R + x);
         F[h][0][std::size_t(y) * std::size_t(R) + std::size_t(x)] = flux[t];
         C[h][0][std::size_t(y) * std::size_t(R) + std::size_t(x)] = double(rays[t]);
-        if (prior) P[h][0][std::size_t(y) * std::size_t(R) + std::size_t(x)] = std::max(0.0, (*prior)[t]);
+        if (prior) {
+          const double v = (*prior)[t];
+          P[h][0][std::size_t(y) * std::size_t(R) + std::size_t(x)] = std::isfinite(v) && v > 0 ? v : 0.0;
+        }
       }
     for (int L = 1; L <= levels; ++L) {
       const std::size_t n = std::size_t(R >> L), m = 2 * n;
@@ -85,7 +89,9 @@ inline std::vector<double> smooth_sparse_map(const std::vector<double>& flux, co
   const double total = F[0][std::size_t(levels)][0] + F[1][std::size_t(levels)][0];
   {
     double w[2];
-    const bool dense = C[0][std::size_t(levels)][0] + C[1][std::size_t(levels)][0] >= 2 * min_rays;
+    // Which hemisphere the rays went to is never in doubt once there is one: a downlight's few rays must
+    // not light the ceiling. Only a map without rays (flux without counts) splits by the prior or area.
+    const bool dense = C[0][std::size_t(levels)][0] + C[1][std::size_t(levels)][0] > 0;
     for (int h = 0; h < 2; ++h)
       w[h] = dense ? F[h][std::size_t(levels)][0] : prior ? P[h][std::size_t(levels)][0] : 0.5 * total;
     const double sum = w[0] + w[1];
