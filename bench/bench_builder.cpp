@@ -8,8 +8,12 @@
 //                    threads, then write_bundle; 10 M rays on 2 threads is the "< 60 s" target.
 //                    peak_rss_MiB is the process's high-water mark (the 10 M rays themselves are 280 MB).
 //   read_tm25/N      stream an N-ray TM-25 file (written first) from the page cache: throughput, memory
+//   build_file/N/T   what `lumx build FILE OUT --threads T` does on an N-ray TM-25 file, by phase
 // Rays: 64 emitters on a 0.3 m ring, 1 mm discs, cos³ lobes tilted outwards, in memory (SoA floats).
 #include <lumx/apl_builder.h>
+#include <lumx/apl_error.h>
+#include <lumx/io/photometry_io.h>
+#include <lumx/ray_photometry.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/rayset_io.h>
 
@@ -45,6 +49,25 @@ RayChunk ring_rays(std::size_t n, unsigned seed) {
   }
   return rays;
 }
+
+/// The ring rays of ring_rays(), generated chunk by chunk (for writing files without holding them).
+class RingSource final : public RaySource {
+ public:
+  explicit RingSource(std::size_t total) { info_.file = "ring", info_.ray_count = total; }
+  const RaysetInfo& info() const override { return info_; }
+  bool next(RayChunk& out, std::size_t max_rays) override {
+    const std::size_t m = std::min<std::size_t>(max_rays, info_.ray_count - done_);
+    if (m == 0) return false;
+    out = ring_rays(m, unsigned(done_ + 3));
+    done_ += m;
+    return true;
+  }
+  void rewind() override { done_ = 0; }
+
+ private:
+  RaysetInfo info_;
+  std::size_t done_ = 0;
+};
 
 double peak_rss_mib() {
   std::ifstream f("/proc/self/status");
@@ -107,23 +130,7 @@ void read_tm25(benchmark::State& state) {
   const std::string path = (std::filesystem::temp_directory_path() / ("lumx_bench_" + std::to_string(::getpid()) + ".tm25ray")).string();
   {
     // Generated chunk by chunk, so writing does not raise the memory high-water mark either.
-    class RingSource final : public RaySource {
-     public:
-      explicit RingSource(std::size_t total) { info_.file = "ring", info_.ray_count = total; }
-      const RaysetInfo& info() const override { return info_; }
-      bool next(RayChunk& out, std::size_t max_rays) override {
-        const std::size_t m = std::min<std::size_t>(max_rays, info_.ray_count - done_);
-        if (m == 0) return false;
-        out = ring_rays(m, unsigned(done_ + 3));
-        done_ += m;
-        return true;
-      }
-      void rewind() override { done_ = 0; }
-
-     private:
-      RaysetInfo info_;
-      std::size_t done_ = 0;
-    } source(n);
+    RingSource source(n);
     write_tm25(path, source.info(), source);
   }
   const double file_bytes = double(std::filesystem::file_size(path));
@@ -137,6 +144,52 @@ void read_tm25(benchmark::State& state) {
   std::filesystem::remove(path);
 }
 BENCHMARK(read_tm25)->Arg(10000000)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+/// What `lumx build FILE OUT --threads T` does, on an N-ray TM-25 file written first: stream the file,
+/// build the levels, evaluate them against the rays (error tables), the far field as IES and LDT, and
+/// write the bundle; each phase's seconds. Run it alone (--benchmark_filter=build_file) for a meaningful
+/// peak_rss_MiB: the in-memory benchmarks above raise the process's high-water mark.
+void build_file(benchmark::State& state) {
+  const std::size_t n = std::size_t(state.range(0));
+  const auto tmp = std::filesystem::temp_directory_path();
+  const std::string path = (tmp / ("lumx_bench_file_" + std::to_string(::getpid()) + ".tm25ray")).string();
+  const std::string dir = (tmp / ("lumx_bench_file_" + std::to_string(::getpid()) + ".lumx")).string();
+  {
+    RingSource source(n);
+    write_tm25(path, source.info(), source);
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  double build_s = 0, eval_s = 0, far_s = 0, write_s = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    const auto rays = open_rayset(path);
+    AplBuildOptions o;
+    o.threads = unsigned(state.range(1));
+    AplSet set = build_apl_set(*rays, o);
+    const auto t1 = Clock::now();
+    AplErrorOptions eo;
+    store_error_tables(set, evaluate_apl_errors(set, *rays, eo));
+    const auto t2 = Clock::now();
+    const Photometry far = far_field_from_rays(*rays, FarFieldGrid{});
+    BundleWriteOptions wo;
+    wo.attachments.push_back({"far_field.ies", "application/x-ies-lm63", format_ies(far)});
+    wo.attachments.push_back({"far_field.ldt", "application/x-eulumdat", format_ldt(far)});
+    const auto t3 = Clock::now();
+    write_bundle(dir, set, nullptr, wo);
+    const auto t4 = Clock::now();
+    build_s = seconds(t0, t1), eval_s = seconds(t1, t2), far_s = seconds(t2, t3), write_s = seconds(t3, t4);
+  }
+  state.counters["file_MiB"] = double(std::filesystem::file_size(path)) / (1 << 20);
+  state.counters["build_s"] = build_s;
+  state.counters["eval_s"] = eval_s;
+  state.counters["far_field_s"] = far_s;
+  state.counters["write_s"] = write_s;
+  state.counters["peak_rss_MiB"] = peak_rss_mib();
+  std::filesystem::remove(path);
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(build_file)->Args({10000000, 2})->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace
 
