@@ -56,6 +56,8 @@ int run_build(const BuildArgs& a) {
     bo.map_resolution = a.map_resolution;
     bo.rays_per_texel = a.rays_per_texel;
     bo.place_at_convergence = a.converge;
+    using LC = lumx::AplBuildOptions::LineClustering;
+    bo.line_clustering = a.cluster_by == "start" ? LC::start_points : a.cluster_by == "line" ? LC::lines : LC::automatic;
     bo.apl_exponent = a.apl_exponent;
     bo.map_smoothing_rays = a.smooth_rays;
     bo.threads = a.threads > 0 ? a.threads : std::max(1u, std::thread::hardware_concurrency());

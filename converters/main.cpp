@@ -130,6 +130,10 @@ const Command kCommands[] = {
                   "treat rays as lines: cluster them by where they come from and place each APL where its rays' "
                   "lines converge (least squares), when inside the luminaire (default); --no-converge: cluster "
                   "start points and place APLs at their box centres (the dissertation's rule)");
+       c.add_option("--cluster-by", g_build.cluster_by,
+                    "with --converge: cluster rays by start point or by where their lines pass (default auto: "
+                    "by line when the lines meet; see docs/apl_sets.md)")
+           ->check(CLI::IsMember({"auto", "start", "line"}));
        c.add_option("--smooth", g_build.smooth_rays,
                     "flux-exact pull-push smoothing of sparse maps: a block of 2x2, 4x4, ... texels with fewer than 4T "
                     "rays shares its light among its quarters like the parent APL's map (default 0: off)")

@@ -557,8 +557,18 @@ TEST(AplBuilder, ClustersByLineOnlyWhenTheLinesMeet) {
       EXPECT_NEAR(r.line_convergence / r.line_convergence_shuffled, 1.0, 0.02) << batwing;
     }
   }
-  {  // separate emitters: start points (their lines do not meet)
+  {  // separate emitters: start points (their lines do not meet), unless lines are forced
     MemoryRaySource rays = emitter_rays(8, 3000, 5);
+    AplBuildReport r;
+    build_apl_set(rays, o, &r);
+    EXPECT_FALSE(r.slid_to_convergence);
+    o.line_clustering = AplBuildOptions::LineClustering::lines;
+    build_apl_set(rays, o, &r);
+    EXPECT_TRUE(r.slid_to_convergence);
+  }
+  {  // and an enclosed source clusters by start point when that is forced
+    MemoryRaySource rays = enclosed_rays(20000, 0.002, 0.02, {0, 0, 0}, 4);
+    o.line_clustering = AplBuildOptions::LineClustering::start_points;
     AplBuildReport r;
     build_apl_set(rays, o, &r);
     EXPECT_FALSE(r.slid_to_convergence);

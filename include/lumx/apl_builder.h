@@ -29,10 +29,10 @@
 // APL's own N/n rays dominate. The rule: R is the largest power of two with
 // 2R² ≤ N / (rays_per_texel · n^apl_exponent), clamped to [min_resolution, max_resolution].
 // apl_exponent = 1 is the per-APL budget, 0 the level's. Measured on the real TM-25 files (lumx eval,
-// patch-averaged relative RMSE, docs/apl_sets.md) the level's budget (0, the default) wins at every d:
-// on the 100 k-ray OSRAM LED the per-APL budget gave R = 4 at 512 APLs and 43 % error at every d, the
-// geometric mean (0.5) R = 16 and 6.2 % at d = 1, the level's budget R = 64 and 3.3 %; on Cyl1M_Faberge,
-// whose APLs share one small emitter, 23 % (R = 16) against 4.5 % (R = 64). The sparse per-APL maps
+// patch-averaged relative RMSE; `lumx build --resolution-exponent E FILE OUT`) the level's budget (0, the
+// default) wins at d ≥ 1: on the 100 k-ray OSRAM LED the per-APL budget gives R = 4 at 512 APLs and 44 %
+// error at every d, the geometric mean (0.5) R = 16 and 6.1 % at d = 1, the level's budget R = 64 and
+// 3.1 %; on Cyl1M_Faberge, whose APLs share one small emitter, 23 % (R = 16) against 4.5 % (R = 64). The sparse per-APL maps
 // this leaves near the luminaire are what the optional flux-exact smoothing (map_smoothing_rays) is for.
 #pragma once
 
@@ -70,6 +70,10 @@ struct AplBuildOptions {
   /// point, instead of clustering start points and placing APLs at their box centres (000 §4.3). On by
   /// default: a measured rayset's start points lie on the recording surface, not on the emitter.
   bool place_at_convergence = true;
+  /// With place_at_convergence: step 1b's choice between clustering start points and the lines' points,
+  /// by its tests (automatic) or forced, e.g. to chart what the tests decide (lumx build --cluster-by).
+  enum class LineClustering { automatic, start_points, lines };
+  LineClustering line_clustering = LineClustering::automatic;
   /// Flux-exact pull-push smoothing of each map (sphere_map_smoothing.h) with this many rays per texel
   /// as the threshold of a reliable texel; 0 = off. Needs power-of-two resolutions.
   double map_smoothing_rays = 0;
@@ -92,6 +96,12 @@ struct AplBuildReport {
   std::vector<std::size_t> apl_count;     ///< per level (may be below the request for tiny raysets)
   double seconds_seed = 0, seconds_tree = 0, seconds_assign = 0;
 };
+
+/// A ray the builder can use: finite position, non-negative finite flux, unit direction (±1e-3).
+inline bool usable_ray(float flux, const glm::vec3& p, const glm::vec3& w) {
+  return flux >= 0 && std::isfinite(flux) && std::isfinite(p.x + p.y + p.z) && std::isfinite(w.x + w.y + w.z) &&
+         std::abs(glm::dot(w, w) - 1.0f) <= 1e-3f;
+}
 
 /// The error for a ray the builder cannot use.
 inline std::string bad_ray_message(std::uint64_t index) {
@@ -142,7 +152,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   }
   if (total == 0) throw std::invalid_argument("build_apl_set: the rayset has no ray");
   const std::uint64_t want = std::min<std::uint64_t>(options.seed_rays, total);
-  std::vector<glm::vec3> seed_pos, seed_dir, seed_orig;
+  std::vector<glm::vec3> seed_pos, seed_dir;
   std::vector<float> seed_flux;
   seed_pos.reserve(std::size_t(want));
   seed_flux.reserve(std::size_t(want));
@@ -152,16 +162,12 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   float max_flux = 0;  // for the fixed-point unit of step 5, gathered in this pass over every ray
   while (rays.next(chunk, options.chunk_rays)) {
     for (float f : chunk.flux) max_flux = std::max(max_flux, std::isfinite(f) ? f : 0.0f);
-    for (std::size_t i = 0; i < chunk.size(); ++i) {
-      const float f = chunk.flux[i];
-      const glm::vec3 p = chunk.position(i), w = chunk.direction(i);
-      if (!(f >= 0) || !std::isfinite(f) || !std::isfinite(p.x + p.y + p.z) || !std::isfinite(w.x + w.y + w.z) ||
-          std::abs(glm::dot(w, w) - 1.0f) > 1e-3f)
-        throw std::invalid_argument(bad_ray_message(index + i));
-    }
     for (std::size_t i = 0; i < chunk.size(); ++i, ++index) {
       // Ray `index` is a seed when ⌊(index+1)·S/N⌋ > ⌊index·S/N⌋: exactly S seeds, evenly spaced.
       if ((index + 1) * want / total == index * want / total) continue;
+      // Seeds are checked here (the tree and step 1b need them sound); every ray is in step 4.
+      if (!usable_ray(chunk.flux[i], chunk.position(i), chunk.direction(i)))
+        throw std::invalid_argument(bad_ray_message(index));
       if (!(chunk.flux[i] > 0)) continue;  // no light, no APL
       seed_pos.push_back(chunk.position(i));
       seed_flux.push_back(chunk.flux[i]);
@@ -208,7 +214,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
   //     measure step 6 minimises (LineFit over the seeds moved to their APLs). This keeps emitters that
   //     merely point away from a common centre apart. Per level, mm², by start point / by line:
   //     Cyl1M_Faberge 0.38 / 0.16 at 8 APLs, 0.12 / 0.006 at 512; the OSRAM LEDs 1.1–2.3× more by line at
-  //     64–512 APLs, yet by line their 8-APL level is 25–35 % better at d = 0.5 (lumx eval): the shift
+  //     64–512 APLs, yet by line their 8-APL level is 24–29 % better at d = 0.5 (`--cluster-by`): the shift
   //     is a proxy;
   //   - the lines do not all meet in one point (the slid seeds' box is not below 1e-4 of the seeds'):
   //     then every clustering by line is degenerate, while start points still split the light by
@@ -236,7 +242,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
                                                  : map_resolution_for(double(total), double(c[k].size()), options);
         std::vector<LineFit> fit(c[k].size());
         for (std::size_t i = 0; i < seed_pos.size(); ++i)
-          if (label[i] >= 0) fit[std::size_t(label[i])].add(seed_orig[i], seed_dir[i], seed_flux[i]);
+          if (label[i] >= 0) fit[std::size_t(label[i])].add(seed_pos[i], seed_dir[i], seed_flux[i]);
         double level_cost = 0, level_weight = 0;
         for (std::size_t i = 0; i < fit.size(); ++i) {
           const glm::dvec3 xi = fit[i].solve(glm::dvec3(t.center(c[k][i])), sphere_map::texel_solid_angle(R));
@@ -264,8 +270,10 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
     // Shuffled, the ratio scatters by about 1/√n around its mean (measured: flat emitters of 100 k seeds
     // 1.000–1.003 of it), so a departure of 10/√n, and at least 3 %, is correlation, not chance.
     const double significant = std::min(0.97, 1.0 - 10.0 / std::sqrt(double(seed_pos.size())));
-    if (glm::length(x - set_bounds.center) <= 1.001 * set_bounds.radius + 1e-9 && start > 0 &&
-        rep.line_convergence <= significant * rep.line_convergence_shuffled) {
+    using LC = AplBuildOptions::LineClustering;
+    const bool inside = glm::length(x - set_bounds.center) <= 1.001 * set_bounds.radius + 1e-9 && start > 0;
+    if (inside && options.line_clustering != LC::start_points &&
+        (options.line_clustering == LC::lines || rep.line_convergence <= significant * rep.line_convergence_shuffled)) {
       std::vector<glm::vec3> slid(seed_pos.size());
       glm::dvec3 slid_lo(slide_to_nearest(seed_pos[0], seed_dir[0], x)), slid_hi = slid_lo;
       for (std::size_t i = 0; i < seed_pos.size(); ++i) {
@@ -273,7 +281,6 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
         slid_lo = glm::min(slid_lo, glm::dvec3(slid[i]));
         slid_hi = glm::max(slid_hi, glm::dvec3(slid[i]));
       }
-      seed_orig = seed_pos;
       ClusterTree slid_tree = build_cluster_tree(slid, seed_flux, co);
       std::vector<std::vector<int>> slid_cuts = make_cuts(slid_tree);
       rep.shift_by_start = shift_cost(tree, cuts);
@@ -282,7 +289,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
                     glm::length(slid_hi - slid_lo) >= 1e-4 * 2.0 * set_bounds.radius;
       for (std::size_t k = 0; better && k < rep.shift_by_line.size(); ++k)
         better = rep.shift_by_line[k] <= 4 * rep.shift_by_start[k];
-      if (better) {
+      if (better || options.line_clustering == LC::lines) {
         slide = true;
         c0 = x;
         tree = std::move(slid_tree);
@@ -292,7 +299,6 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
     }
     rep.slid_to_convergence = slide;
     std::vector<glm::vec3>().swap(seed_dir);
-    std::vector<glm::vec3>().swap(seed_orig);
   }
   const auto t2 = Clock::now();
   rep.seconds_tree = seconds(t1, t2);
@@ -375,8 +381,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
     for (std::size_t i = begin; i < end && error.empty(); ++i) {
       const float f = chunk.flux[i];
       const glm::vec3 p = chunk.position(i), w = chunk.direction(i);
-      if (!(f >= 0) || !std::isfinite(f) || !std::isfinite(p.x + p.y + p.z) || !std::isfinite(w.x + w.y + w.z) ||
-          std::abs(glm::dot(w, w) - 1.0f) > 1e-3f) {
+      if (!usable_ray(f, p, w)) {
         error = bad_ray_message(done + i);
         return;
       }
@@ -465,8 +470,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
     // recorded on a surface around a smaller emitter it is the emitter. Along the axis of a cone of
     // half-angle α the minimum is weakly held (the projectors' mean has an eigenvalue ≈ α²/2), and it
     // sits at the cone's waist, which a map whose texels are wider than the cone cannot express: each
-    // APL's blurred lobe would then light a smaller, brighter spot than its rays do (Cyl1M_Faberge at
-    // 512 APLs, seeds not slid: 94 % off at d = 1). So LineFit::solve takes the components whose
+    // APL's blurred lobe would then light a smaller, brighter spot than its rays do. So LineFit::solve takes the components whose
     // eigenvalue is below Ω, the level's texel solid angle (a cone narrower than ≈ 1.4 texels), from the
     // parent, placed first (the root's anchor is its seeds' box centre). A point outside the luminaire's
     // bound is not used.

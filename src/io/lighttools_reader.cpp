@@ -128,12 +128,7 @@ std::unique_ptr<RaySource> open_lighttools_binary(std::shared_ptr<const RayFile>
   l.unit = *unit;
   l.flux_offset = 40;
   l.flux_field = "total flux";
-  RayFieldNames names;
-  names.position = "ray position";
-  names.direction = "ray direction";
-  names.flux = "ray flux";
-  names.wavelength = "ray wavelength";
-  return make_float_record_source(std::move(file), std::move(info), o, std::move(names), std::move(l));
+  return make_float_record_source(std::move(file), std::move(info), o, RayFieldNames::binary_records(), std::move(l));
 }
 
 std::unique_ptr<RaySource> open_lighttools_text(std::shared_ptr<const RayFile> file, const RaysetReadOptions& o) {

@@ -123,6 +123,9 @@ struct RayFieldNames {
   std::string direction = "direction";
   std::string flux = "flux";
   std::string wavelength = "wavelength";
+
+  /// The names the vendor binary formats (LightTools, Zemax) use in diagnostics.
+  static RayFieldNames binary_records() { return {"ray position", "ray direction", "ray flux", "ray wavelength"}; }
 };
 
 /// Validates one ray and appends it (normalising a direction that is not unit length).
