@@ -1,10 +1,12 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // APL queries against this machine's measured ceiling (Google Benchmark).
 //
 //   build/bench/lumx_bench_apl [--benchmark_filter=...]
 //
 // The set: levels of 1, 8, 64, 256 and 512 APLs with 256 × 512 RGB maps (the dissertation's default,
 // 000 §4.6), filled with smooth random lobes; ~1.3 GB of float maps in memory. Reported per call:
-//   intensity         one bilinear map lookup (sphere_map.h) in a random direction
+//   intensity         one bilinear map lookup (math/sphere_map.h) in a random direction
 //   bare_lookup       the ceiling loop of performance.md §3c, measured here in the same run: bilinear RGB
 //                     lookups at random (map, u, v) over the 512 maps, no direction mapping
 //   irradiance/N      irradiance(x, n) summed over level N at random shading points in a 2 m box, and at
@@ -14,12 +16,12 @@
 //   sample/pdf        SphereMapSampler on a 256 × 512 map
 //   volume            RadianceVolume::radiance at random points and directions (32³, 4 bands, RGB)
 // Bytes per level (memory and disk) are printed by the `bundle_bytes` benchmark as counters.
-#include <lumx/apl_evaluation.h>
-#include <lumx/apl_set.h>
+#include <lumx/apl/evaluation.h>
+#include <lumx/apl/apl_set.h>
 #include <lumx/io/bundle_io.h>
-#include <lumx/radiance_volume.h>
-#include <lumx/spherical_harmonics.h>
-#include <lumx/sphere_map_sampler.h>
+#include <lumx/volume/radiance_volume.h>
+#include <lumx/math/spherical_harmonics.h>
+#include <lumx/math/sphere_map_sampler.h>
 
 #include <benchmark/benchmark.h>
 
@@ -124,7 +126,7 @@ void intensity(benchmark::State& state) {
 }
 BENCHMARK(intensity);
 
-// What the direction → square map costs, against glibc's atan2f that it replaced (sphere_map.h).
+// What the direction → square map costs, against glibc's atan2f that it replaced (math/sphere_map.h).
 void atan2f_alone(benchmark::State& state) {
   over_random_directions(state, 3, [](const glm::vec3& w) { return std::atan2(w.y, w.x); });
 }
@@ -138,7 +140,7 @@ void direction_to_square(benchmark::State& state) {
 }
 BENCHMARK(direction_to_square);
 
-// Real SH up to band 3 (16 coefficients), Sloan's recurrences (spherical_harmonics.h).
+// Real SH up to band 3 (16 coefficients), Sloan's recurrences (math/spherical_harmonics.h).
 void sh_evaluate_4_bands(benchmark::State& state) {
   float y[16];
   over_random_directions(state, 4, [&](const glm::vec3& w) {

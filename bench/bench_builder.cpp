@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Building APL sets from rays (Google Benchmark).
 //
 //   build/bench/lumx_bench_builder [--benchmark_filter=...]
@@ -10,10 +12,10 @@
 //   read_tm25/N      stream an N-ray TM-25 file (written first) from the page cache: throughput, memory
 //   build_file/N/T   what `lumx build FILE OUT --threads T` does on an N-ray TM-25 file, by phase
 // Rays: 64 emitters on a 0.3 m ring, 1 mm discs, cos³ lobes tilted outwards, in memory (SoA floats).
-#include <lumx/apl_builder.h>
-#include <lumx/apl_error.h>
+#include <lumx/apl/builder.h>
+#include <lumx/apl/error.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/ray_photometry.h>
+#include <lumx/rays/far_field.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/rayset_io.h>
 

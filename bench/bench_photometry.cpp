@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Parse + flux throughput on real photometry files (Google Benchmark).
 //
 //   build/bench/lumx_bench_photometry [--benchmark_filter=...]
@@ -5,7 +7,7 @@
 // "all_shared_files" reads every IES and EULUMDAT file under ../shared/data/photometry from memory,
 // parses it and integrates its flux; bytes_per_second is the parse + flux rate over their total size.
 // "lookup" measures one bilinear intensity query on the sample downlight, for reference.
-#include <lumx/intensity_table.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
 
 #include <benchmark/benchmark.h>

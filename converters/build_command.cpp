@@ -1,6 +1,8 @@
-// `lumx build RAYS OUT`: a rayset in, a bundle out — APL levels by clustering (lumx/apl_builder.h), the
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// `lumx build RAYS OUT`: a rayset in, a bundle out — APL levels by clustering (lumx/apl/builder.h), the
 // error of every level against the rays on measurement spheres stored as the levels' error tables
-// (lumx/apl_error.h), and the rays' far field as IES and EULUMDAT attachments (lumx/ray_photometry.h);
+// (lumx/apl/error.h), and the rays' far field as IES and EULUMDAT attachments (lumx/rays/far_field.h);
 // then the speed-against-error table.
 #include "build_command.h"
 
@@ -8,13 +10,13 @@
 #include "eval_commands.h"
 #include "progress.h"
 
-#include <lumx/apl_builder.h>
-#include <lumx/apl_error.h>
-#include <lumx/intensity_table.h>
+#include <lumx/apl/builder.h>
+#include <lumx/apl/error.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/io/rayset_io.h>
-#include <lumx/ray_photometry.h>
+#include <lumx/rays/far_field.h>
 
 #include <chrono>
 #include <cmath>

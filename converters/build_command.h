@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/build_command.h — `lumx build RAYS OUT`: a rayset in, a bundle out.
 #pragma once
 

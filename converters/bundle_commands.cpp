@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // The lumx subcommands applied to bundles (APL sets on disk): info, convert to and from photometry, plot.
 // `check` on a bundle is lumx::check_bundle, called from commands.cpp.
 #include "commands.h"
@@ -5,8 +7,8 @@
 #include "bundle_plot.h"
 #include "cli_support.h"
 
-#include <lumx/apl_photometry.h>
-#include <lumx/intensity_table.h>
+#include <lumx/apl/far_field.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
 

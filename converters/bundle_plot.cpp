@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/bundle_plot.cpp — cairo renderers for APL bundles (sphere-map images, APL position views).
 //
 // Sphere-map image (texel scale s, content width CW = max(2Rs + gap, 600)): title and caption at the top;
@@ -12,7 +14,7 @@
 
 #include "plot_canvas.h"
 
-#include <lumx/photometric_frame.h>
+#include <lumx/photometry/photometric_frame.h>
 
 #include <cairo.h>
 

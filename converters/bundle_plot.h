@@ -1,9 +1,11 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/bundle_plot.h — cairo renderers for APL bundles: one sphere map as a false-colour image, and
 // the APL positions of one level as three orthographic views.
 #pragma once
 
-#include <lumx/apl_set.h>
-#include <lumx/sphere_map.h>
+#include <lumx/apl/apl_set.h>
+#include <lumx/math/sphere_map.h>
 #include <lumx/version.h>
 
 #include <string>

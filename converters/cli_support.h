@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/cli_support.h — what every lumx subcommand shares: printing diagnostics and turning library
 // errors into a located message and exit status 1.
 #pragma once
 
-#include <lumx/diagnostic.h>
+#include <lumx/core/diagnostic.h>
 
 #include <nlohmann/json.hpp>
 

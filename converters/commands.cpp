@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Implementations of the lumx subcommands. Library errors (lumx::Error) are printed as located
 // diagnostics on stderr and turn into exit status 1.
 #include "commands.h"
@@ -7,9 +9,9 @@
 
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometric_metrics.h>
-#include <lumx/resample.h>
-#include <lumx/validate.h>
+#include <lumx/photometry/metrics.h>
+#include <lumx/photometry/resample.h>
+#include <lumx/photometry/validate.h>
 #include <lumx/version.h>
 
 #include <nlohmann/json.hpp>

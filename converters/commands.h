@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // The lumx command-line tool's subcommands. Each returns the process exit status; none calls exit().
 #pragma once
 
-#include <lumx/diagnostic.h>
+#include <lumx/core/diagnostic.h>
 
 #include <string>
 #include <vector>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/eval_commands.cpp — `lumx eval` (see eval_commands.h).
 //
 //   lumx eval BUNDLE --points P.txt [--level K | --lod [--seed S]] [-o OUT]
@@ -5,12 +7,12 @@
 //       precision (%.9g), in the order of the points. The file holds one point per line, "x y z nx ny nz"
 //       (m; the normal is normalised; commas count as spaces); '#' starts a comment; blank lines are
 //       skipped. A bad line is an error located at its line. --lod picks the level per point with
-//       choose_level_by_distance (apl_lod.h, eq. 6.2), drawing its random number from a fixed-seed hash
+//       choose_level_by_distance (apl/lod.h, eq. 6.2), drawing its random number from a fixed-seed hash
 //       of the line number, so a point's result depends only on its line, the seed and the bundle.
 //   lumx eval BUNDLE --rays RAYS [--patches R] [--subsamples k|0] [--distances D,...] [--plots DIR]
 //                    [--plot-format png|svg] [--json] [--store-errors]
 //       The error of every level and of the far field against the rays on measurement spheres
-//       (lumx/apl_error.h): relative RMSE (eq. 5.1) per relative distance with the rays' noise floor,
+//       (lumx/apl/error.h): relative RMSE (eq. 5.1) per relative distance with the rays' noise floor,
 //       ns per irradiance evaluation and bytes per level; then the Hellinger and l² distances. --plots
 //       writes error_vs_distance, error_vs_time and error_vs_bytes. --store-errors writes the relative
 //       RMSE tables into the bundle (rewritten atomically, keeping its volume, attachments and stored
@@ -20,13 +22,13 @@
 #include "cli_support.h"
 #include "eval_plot.h"
 
-#include <lumx/apl_error.h>
-#include <lumx/apl_evaluation.h>
-#include <lumx/apl_lod.h>
+#include <lumx/apl/error.h>
+#include <lumx/apl/evaluation.h>
+#include <lumx/apl/lod.h>
 #include <lumx/io/atomic_file.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/rayset_io.h>
-#include <lumx/radiance_volume.h>
+#include <lumx/volume/radiance_volume.h>
 
 #include <nlohmann/json.hpp>
 

@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/eval_commands.h — `lumx eval`: a bundle's irradiance at user-given points, and its error
-// against a rayset on measurement spheres (lumx/apl_error.h) as a table and plots.
+// against a rayset on measurement spheres (lumx/apl/error.h) as a table and plots.
 #pragma once
 
-#include <lumx/apl_error.h>
+#include <lumx/apl/error.h>
 
 #include <string>
 #include <vector>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/eval_plot.cpp — log-log line charts (see eval_plot.h).
 //
 // Layout (W × H): title and caption at the top; the plot area below with a left margin for the y tick
@@ -8,7 +10,7 @@
 
 #include "plot_canvas.h"
 
-#include <lumx/photometric_frame.h>
+#include <lumx/photometry/photometric_frame.h>
 
 #include <cairo.h>
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/eval_plot.h — log-log line charts for `lumx eval --rays --plots`: error against relative
 // distance per level (the dissertation's Figure 5.8), error against evaluation time and against bytes.
 #pragma once

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // lumx — command-line tool for luminaire data: info, check, convert, plot.
 //
 // Subcommands and their one-line help come from one table (kCommands); CLI11 renders `lumx --help`,

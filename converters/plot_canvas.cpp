@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/plot_canvas.cpp — the cairo plumbing shared by the plot renderers (see plot_canvas.h).
 #include "plot_canvas.h"
 
-#include <lumx/diagnostic.h>
+#include <lumx/core/diagnostic.h>
 #include <lumx/io/atomic_file.h>
 
 #include <cairo-svg.h>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/plot_canvas.h — the cairo plumbing shared by the plot renderers (polar_plot.cpp for the polar
 // intensity diagram, bundle_plot.cpp for sphere-map images and APL position views): RAII handles, the
 // error helper, the datasheet number format, the text colours, the Painter (fonts and text placement), and

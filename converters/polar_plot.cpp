@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/polar_plot.cpp — cairo renderer for the polar intensity diagram.
 //
 // Layout (S = options.size_px, image S x round(1.02 S)): title and caption at the top; the polar grid in
@@ -9,7 +11,7 @@
 
 #include "plot_canvas.h"
 
-#include <lumx/polar_diagram.h>
+#include <lumx/photometry/polar_diagram.h>
 
 #include <cairo.h>
 

@@ -1,7 +1,9 @@
-// converters/polar_plot.h — renders the polar intensity diagram (lumx/polar_diagram.h) with cairo.
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// converters/polar_plot.h — renders the polar intensity diagram (lumx/photometry/polar_diagram.h) with cairo.
 #pragma once
 
-#include <lumx/photometry.h>
+#include <lumx/photometry/photometry.h>
 #include <lumx/version.h>
 
 #include <string>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // converters/progress.h — a one-line progress bar with rate and ETA on stderr, for long runs.
 //
 // Updates at most ten times a second, and only when stderr is a terminal (or when forced), so logs and

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // The lumx subcommands applied to raysets (TM-25, LightTools, Zemax, plain text): info and check. Rays are
 // streamed (lumx::summarize_rays), so a file of any size is summarised in a few MiB.
 #include "commands.h"

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // samples/ring_luminaire.cpp — embedding lumx: build an APL set and a radiance volume by hand, ship them as
 // a bundle, then load only what a scene needs and light it.
 //
@@ -12,12 +14,12 @@
 // What it prints: the bundle's size, the bytes a distant scene reads (level 8 at reduced resolution),
 // and irradiance below the luminaire from each level and from the LOD rule (eq. 6.2), against the exact
 // sum over the 64 LEDs' analytic lobes.
-#include <lumx/apl_evaluation.h>
-#include <lumx/apl_lod.h>
-#include <lumx/apl_photometry.h>
+#include <lumx/apl/evaluation.h>
+#include <lumx/apl/lod.h>
+#include <lumx/apl/far_field.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/radiance_volume.h>
+#include <lumx/volume/radiance_volume.h>
 
 #include <cmath>
 #include <cstdio>

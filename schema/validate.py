@@ -1,4 +1,6 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
 """Validate lumx bundle manifests against schema/bundle-manifest.schema.json (Debian: python3-jsonschema).
 
 Usage: validate.py MANIFEST_OR_BUNDLE... ; exit status 0 when every manifest is valid, 1 otherwise.

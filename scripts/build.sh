@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
 # Builds lumx (installing missing Debian packages first). Usage: scripts/build.sh [--sanitize]
 #   default      -> build/        (RelWithDebInfo, warnings as errors)
 #   --sanitize   -> build-asan/   (Debug, AddressSanitizer + UndefinedBehaviorSanitizer)

@@ -1,4 +1,6 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
 """Charts `lumx build` (rays as lines, the default) against `lumx build --no-converge` on synthetic
 luminaires, the study behind docs/apl_sets.md "Charted on synthetic luminaires".
 

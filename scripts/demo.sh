@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
 # README command 1: build everything, then run the main job on the bundled samples, all into out/demo/:
 #  1. the measured OSRAM LED rayset (TM-25) -> a lumx bundle: APL levels by clustering, each level's error
 #     against the rays, the far field; prints the speed-against-error table, writes its plots;

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
 # Installs the Debian 12 packages lumx builds against, if any is missing (needs root or sudo).
 set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Helpers shared by tests/test_bad_input_ies.cpp and tests/test_bad_input_ldt.cpp: the bad-input corpus
 // in tests/data/bad (regenerate with tests/data/bad/make_corpus.py), locating text in it by line, checking
 // the located-error contract of lumx::Error, and the "never crash" sweep.
@@ -5,9 +7,9 @@
 
 #include "test_support.h"
 
-#include <lumx/diagnostic.h>
+#include <lumx/core/diagnostic.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometry.h>
+#include <lumx/photometry/photometry.h>
 
 #include <gtest/gtest.h>
 

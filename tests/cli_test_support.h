@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Running the lumx command-line tool from tests, as a user would (popen of LUMX_CLI_PATH).
 #pragma once
 

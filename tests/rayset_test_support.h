@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Helpers shared by the rayset tests: the real files in ../shared/data/raysets, the independent Python
 // reference (tests/tools/rayset_reference.py), a byte-level TM-25 builder for hostile files, scratch
 // folders, and a RaySource that computes rays on the fly (no storage) for the memory tests.
@@ -6,7 +8,7 @@
 #include "test_support.h"
 
 #include <lumx/io/rayset_io.h>
-#include <lumx/rayset.h>
+#include <lumx/rays/rayset.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -1,11 +1,13 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Clustering seeds into a tree (eq. 4.1, PLOC) and building APL sets from raysets: tree invariants,
 // quality against exact greedy merging, nested cuts, flux conservation, hard cases (one point, duplicate
 // positions, fewer rays than APLs, zero-flux rays, flux spanning 10^6) and determinism.
-#include <lumx/apl_builder.h>
-#include <lumx/apl_error.h>
-#include <lumx/apl_photometry.h>
-#include <lumx/intensity_table.h>
-#include <lumx/ray_photometry.h>
+#include <lumx/apl/builder.h>
+#include <lumx/apl/error.h>
+#include <lumx/apl/far_field.h>
+#include <lumx/photometry/intensity_table.h>
+#include <lumx/rays/far_field.h>
 #include <lumx/io/bundle_io.h>
 
 #include <gtest/gtest.h>

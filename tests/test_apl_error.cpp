@@ -1,11 +1,13 @@
-// Reference evaluators (apl_error.h): the metrics on hand-computed examples, the gathering of rays on
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// Reference evaluators (apl/error.h): the metrics on hand-computed examples, the gathering of rays on
 // measurement spheres (exits, rays starting outside, halves), the noise floor against an exact model and
 // its 1/√rays scaling, errors of built APL sets against their rays (decrease with level near the
 // luminaire, agreement far away, a point source, the measured OSRAM sample), determinism, and error tables
 // through a bundle.
-#include <lumx/apl_builder.h>
-#include <lumx/apl_error.h>
-#include <lumx/apl_lod.h>
+#include <lumx/apl/builder.h>
+#include <lumx/apl/error.h>
+#include <lumx/apl/lod.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/rayset_io.h>
 

@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Sampling an APL level: emission samples carry the right flux and their pdfs agree exactly; light
 // selection at a shading point is normalised, consistent and gives an unbiased irradiance estimator.
-#include <lumx/apl_evaluation.h>
-#include <lumx/apl_sampling.h>
+#include <lumx/apl/evaluation.h>
+#include <lumx/apl/sampling.h>
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,13 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // APL sets: the model's consistency rules, intensity and irradiance queries, the LOD rules and the far
 // field, on hand-made sets whose answers follow from the inverse-square law and from the levels being
 // cuts of one tree.
-#include <lumx/apl_evaluation.h>
-#include <lumx/apl_lod.h>
-#include <lumx/apl_photometry.h>
-#include <lumx/apl_set.h>
-#include <lumx/intensity_table.h>
+#include <lumx/apl/evaluation.h>
+#include <lumx/apl/lod.h>
+#include <lumx/apl/far_field.h>
+#include <lumx/apl/apl_set.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
 
 #include <gtest/gtest.h>

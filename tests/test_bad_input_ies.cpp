@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Bad and awkward IES LM-63 input: hard-cases.md §6 items 1-10, written from the contract
 // (include/lumx/io/photometry_io.h, formats.md §1) without reference to the reader's source.
 //
@@ -7,12 +9,12 @@
 // regenerates it); each file is named after its class.
 #include "bad_input_support.h"
 
-#include <lumx/intensity_table.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometric_frame.h>
-#include <lumx/photometry.h>
-#include <lumx/resample.h>
-#include <lumx/symmetry.h>
+#include <lumx/photometry/photometric_frame.h>
+#include <lumx/photometry/photometry.h>
+#include <lumx/photometry/resample.h>
+#include <lumx/photometry/symmetry.h>
 
 #include <gtest/gtest.h>
 

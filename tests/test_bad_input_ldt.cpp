@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Bad and awkward EULUMDAT input: hard-cases.md §6 items 11-16, written from the contract
 // (include/lumx/io/photometry_io.h, formats.md §2) without reference to the reader's source.
 //
@@ -9,10 +11,10 @@
 // intensities from 56.
 #include "bad_input_support.h"
 
-#include <lumx/intensity_table.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometry.h>
-#include <lumx/symmetry.h>
+#include <lumx/photometry/photometry.h>
+#include <lumx/photometry/symmetry.h>
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,12 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Bundles on disk: round trips, half/float choice, partial loading (bytes read), atomic replacement,
 // and located rejection of corrupted, truncated, inconsistent or hostile bundles.
-#include <lumx/apl_photometry.h>
-#include <lumx/apl_set.h>
+#include <lumx/apl/far_field.h>
+#include <lumx/apl/apl_set.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/radiance_volume.h>
+#include <lumx/volume/radiance_volume.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -15,8 +17,8 @@
 #include <fstream>
 #include <random>
 
-#include "io/exr_image.h"
-#include "io/sha256.h"
+#include "io/bundle/exr_image.h"
+#include "io/bundle/sha256.h"
 #include "test_support.h"
 
 using namespace lumx;

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // The lumx command-line tool as a user runs it: help, version, usage errors, and each subcommand on
 // real files.
 #include <gtest/gtest.h>

@@ -1,9 +1,11 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // `lumx eval` as a user runs it: irradiance at points (--level, --lod, located errors for bad lines), the
 // error report against a TM-25 rayset (table, JSON equal to the library's numbers, plots, error tables
 // stored in the bundle), and usage errors.
-#include <lumx/apl_builder.h>
-#include <lumx/apl_error.h>
-#include <lumx/apl_evaluation.h>
+#include <lumx/apl/builder.h>
+#include <lumx/apl/error.h>
+#include <lumx/apl/evaluation.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/rayset_io.h>
 

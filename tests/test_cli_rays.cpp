@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // `lumx info` and `lumx check` on raysets, as a user runs them: real files, a plain-text file, a broken
 // file (located finding, exit 1), and photometry files still taking their own path.
 #include <gtest/gtest.h>

@@ -1,9 +1,11 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // IES <-> EULUMDAT conversion: flux within 0.1 % (in practice ~1e-7: both formats carry the same
 // table) and candela at the stored angles to the written precision, in both directions, on every
 // real file.
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometric_metrics.h>
-#include <lumx/resample.h>
+#include <lumx/photometry/metrics.h>
+#include <lumx/photometry/resample.h>
 
 #include <gtest/gtest.h>
 

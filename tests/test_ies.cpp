@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // IES LM-63 reading and writing on real files and on synthetic files for what no real file covers.
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometric_metrics.h>
-#include <lumx/resample.h>
-#include <lumx/validate.h>
+#include <lumx/photometry/metrics.h>
+#include <lumx/photometry/resample.h>
+#include <lumx/photometry/validate.h>
 
 #include <gtest/gtest.h>
 

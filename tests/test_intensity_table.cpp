@@ -1,6 +1,8 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Analytic checks of the full-sphere table: flux integral, interpolation, seams and poles.
-#include <lumx/intensity_table.h>
-#include <lumx/photometric_metrics.h>
+#include <lumx/photometry/intensity_table.h>
+#include <lumx/photometry/metrics.h>
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,12 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // EULUMDAT reader and writer: every real .ldt file, round trips, exact symmetry expansion
 // (hard-cases.md §6 #16) and the bad-input checklist (#11-#15).
-#include <lumx/diagnostic.h>
-#include <lumx/intensity_table.h>
+#include <lumx/core/diagnostic.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometry.h>
-#include <lumx/symmetry.h>
+#include <lumx/photometry/photometry.h>
+#include <lumx/photometry/symmetry.h>
 
 #include <gtest/gtest.h>
 

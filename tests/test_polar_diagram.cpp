@@ -1,4 +1,6 @@
-// Analytic checks of lumx/polar_diagram.h on hand-built photometry.
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// Analytic checks of lumx/photometry/polar_diagram.h on hand-built photometry.
 //
 // Interpolation bound used throughout: the curves are sampled from IntensityTable's bilinear interpolant.
 // Along a plane that coincides with stored planes (C0, C90, C180, C270 here) the azimuth weight is 0 or 1,
@@ -6,7 +8,7 @@
 // f(gamma) tabulated every h radians, linear interpolation is off by at most h^2/8 * max|f''|
 // (the classic bound (x - a)(b - x)/2 * |f''| <= h^2/8 |f''|). For f = I0 cos g, |f''| <= I0; for
 // f = I0 cos^3 g, f'' = 6 cos g - 9 cos^3 g, so |f''| <= 3 I0 on [0, 90] degrees.
-#include <lumx/polar_diagram.h>
+#include <lumx/photometry/polar_diagram.h>
 
 #include <gtest/gtest.h>
 

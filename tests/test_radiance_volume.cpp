@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Radiance volume: grid layout, mass conservation of the voxel traversal (random segments, axis-parallel
 // rays, rays on faces, edges and corners, negative coordinates), the isotropic-field estimate, the
 // windowed and clamped query, and merging partial volumes.
-#include <lumx/aabb.h>
-#include <lumx/radiance_volume.h>
+#include <lumx/math/aabb.h>
+#include <lumx/volume/radiance_volume.h>
 
 #include <gtest/gtest.h>
 

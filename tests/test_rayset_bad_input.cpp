@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Hostile and broken ray files (hard-cases.md §6, items 17-20): truncation at every kind of offset, wrong
 // magic and versions, flags that contradict each other, counts larger than the file or overflowing, huge
 // text and table sizes, NaN/zero directions and bad fluxes, broken text files, and a mutation sweep. Every

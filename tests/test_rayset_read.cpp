@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Reading raysets: every real file in ../shared/data/raysets against an independent reading by
 // tests/tools/rayset_reference.py (Python, struct module), the three-ray files across formats, TM-25
 // header facts, chunking and rewinding, and the text formats (plain text, LightTools, Zemax).

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // The TM-25 writer: write-then-read is exact (the rays' bits, the header), writing is atomic, values TM-25
 // cannot hold are refused; and rays stream in bounded memory (a 2 M-ray file written and read with peak
 // RSS growth far below its size), with the read speed on the largest real file reported.

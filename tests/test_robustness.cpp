@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Regression tests for hostile values reaching the model, writers and file system helpers.
 #include <lumx/io/atomic_file.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/resample.h>
+#include <lumx/photometry/resample.h>
 
 #include <gtest/gtest.h>
 

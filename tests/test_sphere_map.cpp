@@ -1,10 +1,12 @@
-// Independent checks of lumx/sphere_map.h: the concentric + Lambert transform both ways, equal solid
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// Independent checks of lumx/math/sphere_map.h: the concentric + Lambert transform both ways, equal solid
 // angle per texel, bilinear lookups across the equator seam, the squares' corners and the poles, and the
 // map's integral under splatting and downsampling. All random inputs come from fixed seeds.
 //
 // The last group of tests guards defects this suite found in a first version (corner seams, exact
 // constants, the shared u = 0.5 edge, precision at the poles); each names the fix.
-#include <lumx/sphere_map.h>
+#include <lumx/math/sphere_map.h>
 
 #include <gtest/gtest.h>
 
@@ -489,7 +491,7 @@ TEST(SphereMap, LayoutSizesAndSolidAngle) {
   EXPECT_EQ(c, 2);
 }
 
-// ---- regressions: defects found in the first version of sphere_map.h ----------------------------------
+// ---- regressions: defects found in the first version of math/sphere_map.h ----------------------------------
 
 // fetch() flips to the other square once even when both coordinates are outside (past a corner). Along
 // the equator within half a texel of a corner the two squares then weight the two corner texels U, L

@@ -1,4 +1,6 @@
-// Tests of lumx/piecewise_constant_2d.h and lumx/sphere_map_sampler.h.
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// Tests of lumx/math/piecewise_constant_2d.h and lumx/math/sphere_map_sampler.h.
 //
 // The sampler is checked the way pbrt-v4's and Mitsuba's warp tests check theirs: many samples are
 // binned into a (cos θ, φ) histogram, the expected count of each bin is the sampler's own pdf()
@@ -7,8 +9,8 @@
 // significance 0.01 after a Šidák correction for the kGoodnessOfFitTests tests in this file. Exactness
 // properties (pdf of a sample equals pdf of its direction, no sample in a zero texel, the pdf
 // integrates to 1) are checked directly. All random inputs come from fixed seeds.
-#include <lumx/piecewise_constant_2d.h>
-#include <lumx/sphere_map_sampler.h>
+#include <lumx/math/piecewise_constant_2d.h>
+#include <lumx/math/sphere_map_sampler.h>
 
 #include <gtest/gtest.h>
 

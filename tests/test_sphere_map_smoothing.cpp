@@ -1,6 +1,8 @@
-// Flux-exact pull-push smoothing of sparse sphere-map histograms (sphere_map_smoothing.h).
-#include <lumx/sphere_map.h>
-#include <lumx/sphere_map_smoothing.h>
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// Flux-exact pull-push smoothing of sparse sphere-map histograms (math/sphere_map_smoothing.h).
+#include <lumx/math/sphere_map.h>
+#include <lumx/math/sphere_map_smoothing.h>
 
 #include <gtest/gtest.h>
 

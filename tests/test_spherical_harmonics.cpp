@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Real spherical harmonics against independent oracles: hand-written polynomials, orthonormality by exact
 // quadrature, the clamped-cosine coefficients of Ramamoorthi & Hanrahan, rotation invariance of band
 // energy, and the positivity of windowed narrow lobes.
-#include <lumx/spherical_harmonics.h>
+#include <lumx/math/spherical_harmonics.h>
 
 #include <gtest/gtest.h>
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Shared helpers for the test suite: where the test data lives.
 #pragma once
 

@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Symmetry expansion and compaction, C-plane rotation, photometric frames.
-#include <lumx/photometric_frame.h>
-#include <lumx/resample.h>
-#include <lumx/symmetry.h>
+#include <lumx/photometry/photometric_frame.h>
+#include <lumx/photometry/resample.h>
+#include <lumx/photometry/symmetry.h>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>

@@ -1,5 +1,7 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Atomic replacement of a file (hard-cases.md §4) and bounded whole-file reads.
-#include <lumx/diagnostic.h>
+#include <lumx/core/diagnostic.h>
 #include <lumx/io/atomic_file.h>
 
 #include <cerrno>

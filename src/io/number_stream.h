@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Internal: a cursor over the numbers of a text, reporting every problem at the number's line.
 //
 // It scans the text in place (numbers separated by blanks, tabs, commas or line breaks — the LM-63-2002
@@ -5,7 +7,7 @@
 // make the reader allocate per token. remaining() counts ahead without storing anything.
 #pragma once
 
-#include <lumx/diagnostic.h>
+#include <lumx/core/diagnostic.h>
 
 #include "io/text_scanner.h"
 

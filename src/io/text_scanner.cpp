@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 #include "io/text_scanner.h"
 
 #include <algorithm>

@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Internal: line splitting, tokenising and strict number parsing shared by the text-format readers.
 #pragma once
 
-#include <lumx/diagnostic.h>
+#include <lumx/core/diagnostic.h>
 
 #include <cstdint>
 #include <string>

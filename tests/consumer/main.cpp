@@ -1,6 +1,8 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // Reads an IES file through the installed lumx and prints its flux; exits non-zero on failure.
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometric_metrics.h>
+#include <lumx/photometry/metrics.h>
 #include <lumx/version.h>
 
 #include <cstdio>

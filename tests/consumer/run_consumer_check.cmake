@@ -1,3 +1,5 @@
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
 # Installs the already-built lumx into WORK_DIR/prefix, builds tests/consumer against it, runs it.
 file(REMOVE_RECURSE ${WORK_DIR})
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${LUMX_BINARY_DIR} --prefix ${WORK_DIR}/prefix

@@ -1,13 +1,15 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // libFuzzer target: any bytes through both readers, validation, the intensity table and both writers.
 // Only lumx::Error may come out of a reader; a table that was read must survive everything after it.
 //
 //   cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DLUMX_BUILD_FUZZERS=ON -DLUMX_BUILD_CLI=OFF \
 //         -DLUMX_BUILD_TESTS=OFF -DLUMX_BUILD_BENCH=OFF && cmake --build build-fuzz
 //   build-fuzz/tests/fuzz/lumx_fuzz_photometry tests/data/bad tests/data/photometry/*/ -max_total_time=300
-#include <lumx/intensity_table.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
-#include <lumx/photometric_metrics.h>
-#include <lumx/validate.h>
+#include <lumx/photometry/metrics.h>
+#include <lumx/photometry/validate.h>
 
 #include <cstdint>
 #include <cstdlib>

@@ -1,4 +1,6 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
 """Independent reference figures for a ray file, for tests/test_rayset_read.cpp.
 
 Standard library only (struct, math, json). Written from the format descriptions (docs/rays.md,

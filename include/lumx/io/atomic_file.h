@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // lumx/io/atomic_file.h — replace a file's contents all at once or not at all.
 //
 // Write to a temporary file in the target's folder, fsync it, close it (checking the result), rename it

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // lumx/io/bundle_io.h — the lumx bundle: an APL set (and optionally a radiance volume) on disk.
 //
 // A bundle is a folder:
@@ -22,9 +24,9 @@
 // leaves the previous bundle as it was.
 #pragma once
 
-#include <lumx/apl_set.h>
-#include <lumx/diagnostic.h>
-#include <lumx/spherical_harmonics.h>
+#include <lumx/apl/apl_set.h>
+#include <lumx/core/diagnostic.h>
+#include <lumx/math/spherical_harmonics.h>
 
 #include <cstdint>
 #include <optional>

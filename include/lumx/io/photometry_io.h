@@ -1,6 +1,8 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // lumx/io/photometry_io.h — reading and writing IES LM-63 and EULUMDAT files.
 //
-// The format layer on top of the model in lumx/photometry.h. Each format has a reader and a writer
+// The format layer on top of the model in lumx/photometry/photometry.h. Each format has a reader and a writer
 // (src/io/ies_reader.cpp, ies_writer.cpp, ldt_reader.cpp, ldt_writer.cpp); read_photometry() picks one by
 // file extension and falls back to sniffing the content. Readers are permissive about what real files do
 // (formats.md §1.6, §2.4) and report it as warnings; they throw lumx::Error, located by file, line and
@@ -8,8 +10,8 @@
 // actually present before anything is allocated from them.
 #pragma once
 
-#include <lumx/diagnostic.h>
-#include <lumx/photometry.h>
+#include <lumx/core/diagnostic.h>
+#include <lumx/photometry/photometry.h>
 
 #include <cstddef>
 #include <optional>

@@ -1,6 +1,8 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
 // lumx/io/rayset_io.h — reading raysets (IES TM-25, LightTools, Zemax, plain text) and writing TM-25.
 //
-// The format layer on top of lumx/rayset.h. A rayset is opened as a RaySource, which reads the file's
+// The format layer on top of lumx/rays/rayset.h. A rayset is opened as a RaySource, which reads the file's
 // header at once (checking every count against the file size before anything is allocated from it) and
 // then hands out rays in chunks: the file is read through a bounded window (pread), never whole, so a
 // 10 M-ray file is processed in a few MiB of memory. Implementations are in src/io/tm25_reader.cpp,
@@ -19,8 +21,8 @@
 // NaN, infinite or negative fluxes, are errors.
 #pragma once
 
-#include <lumx/diagnostic.h>
-#include <lumx/rayset.h>
+#include <lumx/core/diagnostic.h>
+#include <lumx/rays/rayset.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -64,7 +66,7 @@ struct RaysetReadOptions {
   PhotometricQuantity zemax_text_quantity = PhotometricQuantity::radiometric;
 };
 
-// RaySource (the stream every reader returns) and MemoryRaySource (rays in memory) are in lumx/rayset.h.
+// RaySource (the stream every reader returns) and MemoryRaySource (rays in memory) are in lumx/rays/rayset.h.
 // The readers' next() throws lumx::Error, located at the ray's byte offset or line, for a ray that is not
 // valid; after an error, rewind() before reading again.
 

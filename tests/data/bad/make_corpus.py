@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
 """Regenerates the bad-input corpus in this folder (tests/data/bad).
 
 One small file per bad-input class of shared/docs/hard-cases.md section 6 (items 1-16), plus the valid

@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// lumx/apl/apl_set.h — the in-memory model of an APL set: anisotropic point lights in levels of detail.
+//
+// An anisotropic point light (APL) is a point at a fixed position that emits with a direction-dependent
+// intensity, stored as an equal-area sphere map (dissertation 000 §4.3; algorithms.md §2). A luminaire's
+// APL set has several levels (e.g. 1, 8, 64, 256, 512 APLs). Each level is a cut of one agglomerative
+// cluster tree, so every APL of level k has a parent in level k−1 and the parents' fluxes are the sums of
+// their children's (000 §6.1). Level 1 is the classic far-field point source.
+//
+// This header is the data model only; queries live in apl/evaluation.h, apl/sampling.h and apl/lod.h,
+// and the file form in io/bundle_io.h (the OpenVDB split of model and I/O).
+#pragma once
+
+#include <lumx/core/units.h>
+#include <lumx/math/bounding_sphere.h>
+#include <lumx/math/sphere_map.h>
+
+#include <glm/glm.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+LUMX_NAMESPACE_BEGIN
+
+/// One anisotropic point light.
+struct Apl {
+  glm::vec3 position{0.0f};  ///< m, in the luminaire's photometric frame
+  glm::dvec3 flux{0.0};      ///< lm or W per channel (one-channel sets repeat Y); equals map.integral()
+  int parent = -1;           ///< index of the APL in the previous (coarser) level; −1 in the first level
+  SphereMap map;             ///< intensity, cd or W/sr per channel
+};
+
+/// Relative RMSE of a level's irradiance against a reference, on spheres of relative distance d
+/// (000 §5.3, eq. 5.1). Filled by the builder (issue 4); read by the error-target level choice.
+struct ErrorTable {
+  std::vector<double> relative_distance;  ///< d = |x − c| / D, increasing
+  std::vector<double> relative_rmse;      ///< one per distance
+  bool empty() const { return relative_distance.empty(); }
+};
+
+struct AplLevel {
+  int map_resolution = 0;  ///< R of every map in this level (image 2R × R)
+  std::vector<Apl> apls;
+  ErrorTable error;
+
+  std::size_t size() const { return apls.size(); }
+  /// Total flux per channel: Σ APL flux.
+  glm::dvec3 flux() const {
+    glm::dvec3 f(0.0);
+    for (const Apl& a : apls) f += a.flux;
+    return f;
+  }
+  /// Bytes of map data held in memory.
+  std::size_t map_bytes() const {
+    std::size_t b = 0;
+    for (const Apl& a : apls) b += a.map.bytes();
+    return b;
+  }
+};
+
+/// A luminaire's APL set: levels ordered by increasing APL count, plus what a reader needs to use it.
+struct AplSet {
+  PhotometricQuantity quantity = PhotometricQuantity::photometric;
+  ChannelLayout channels = ChannelLayout::luminance;
+  BoundingSphere bounds;                           ///< encloses the luminaire (for the LOD distance)
+  std::map<std::string, std::string> provenance;   ///< free-form: source file, generator, seed, ...
+  std::vector<AplLevel> levels;
+
+  /// Relative distance of x from the luminaire, d = |x − c| / D with D the bounding diameter (000 Fig. 6.1).
+  double relative_distance(const glm::dvec3& x) const {
+    const double diameter = 2.0 * bounds.radius;
+    return diameter > 0 ? glm::length(x - bounds.center) / diameter : INFINITY;
+  }
+};
+
+/// Recomputes every APL's flux from its map (Σ texel × solid angle), the value the manifest stores.
+inline void update_fluxes(AplSet& set) {
+  for (AplLevel& level : set.levels)
+    for (Apl& a : level.apls) a.flux = a.map.integral();
+}
+
+/// The smallest sphere-like bound we can compute cheaply: the centre of the APL positions' box and the
+/// largest distance to it. Builders that know the geometry should set a tighter one themselves.
+inline BoundingSphere bounding_sphere_of(const AplSet& set) {
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const AplLevel& l : set.levels)
+    for (const Apl& a : l.apls) {
+      lo = glm::min(lo, glm::dvec3(a.position));
+      hi = glm::max(hi, glm::dvec3(a.position));
+    }
+  BoundingSphere s;
+  if (!(lo.x <= hi.x)) return s;
+  s.center = 0.5 * (lo + hi);
+  for (const AplLevel& l : set.levels)
+    for (const Apl& a : l.apls) s.radius = std::max(s.radius, glm::length(glm::dvec3(a.position) - s.center));
+  return s;
+}
+
+/// Consistency rules of a set; each violation is one message naming the level, APL and field.
+///   - at least one level; levels strictly increasing in APL count; no empty level;
+///   - every map has the level's resolution and the set's channel count; values finite and ≥ 0;
+///   - positions, the bounding sphere and fluxes finite, fluxes ≥ 0; error tables well formed;
+///   - parent indices valid (−1 in level 0, in range afterwards);
+///   - each APL's flux equals its map's integral within `flux_tolerance` relative (plus 1e-6 of the level's
+///     flux, for APLs with next to no flux);
+///   - each parent's flux equals the sum of its children's, with the same tolerance (cuts of one tree).
+inline std::vector<std::string> check_apl_set(const AplSet& set, double flux_tolerance = 1e-3) {
+  std::vector<std::string> out;
+  const int nc = channel_count(set.channels);
+  if (set.levels.empty()) out.push_back("levels: the set has no level");
+  if (!(set.bounds.radius >= 0) || !std::isfinite(set.bounds.radius))
+    out.push_back("bounding_sphere.radius: not a finite non-negative number");
+  if (!std::isfinite(set.bounds.center.x) || !std::isfinite(set.bounds.center.y) || !std::isfinite(set.bounds.center.z))
+    out.push_back("bounding_sphere.center: not finite");
+  for (std::size_t k = 0; k < set.levels.size(); ++k) {
+    const AplLevel& level = set.levels[k];
+    const std::string where = "levels[" + std::to_string(k) + "]";
+    if (level.apls.empty()) out.push_back(where + ": no APL");
+    if (k > 0 && level.apls.size() <= set.levels[k - 1].apls.size())
+      out.push_back(where + ": APL count " + std::to_string(level.apls.size()) +
+                    " does not exceed the previous level's");
+    const ErrorTable& e = level.error;
+    bool table_ok = e.relative_rmse.size() == e.relative_distance.size() && e.relative_distance.size() <= 4096;
+    for (std::size_t j = 0; table_ok && j < e.relative_distance.size(); ++j)
+      table_ok = e.relative_distance[j] > 0 && std::isfinite(e.relative_distance[j]) &&
+                 (j == 0 || e.relative_distance[j] > e.relative_distance[j - 1]) && e.relative_rmse[j] >= 0 &&
+                 std::isfinite(e.relative_rmse[j]);
+    if (!table_ok)
+      out.push_back(where + ".error: distances must be positive, finite and increasing, errors finite and ≥ 0, "
+                            "one error per distance (at most 4096)");
+    const double level_flux = luminance_of(set.channels, level.flux());
+    const double floor_tol = 1e-6 * std::abs(level_flux);
+    auto tol = [&](const glm::dvec3& f) { return flux_tolerance * std::abs(luminance_of(set.channels, f)) + floor_tol; };
+    for (std::size_t i = 0; i < level.apls.size(); ++i) {
+      const Apl& a = level.apls[i];
+      const std::string at = where + ".apls[" + std::to_string(i) + "]";
+      if (!std::isfinite(a.position.x) || !std::isfinite(a.position.y) || !std::isfinite(a.position.z))
+        out.push_back(at + ".position: not finite");
+      for (int c = 0; c < nc; ++c)
+        if (!(a.flux[c] >= 0) || !std::isfinite(a.flux[c])) {
+          out.push_back(at + ".flux: channel " + std::to_string(c) + " is negative or not finite");
+          break;
+        }
+      if (a.map.resolution() != level.map_resolution || a.map.channels() != nc) {
+        out.push_back(at + ".map: resolution " + std::to_string(a.map.resolution()) + " × " +
+                      std::to_string(a.map.channels()) + " channels, expected " +
+                      std::to_string(level.map_resolution) + " × " + std::to_string(nc));
+        continue;
+      }
+      int bx = 0, by = 0, bc = 0;
+      if (!a.map.all_finite_nonnegative(&bx, &by, &bc))
+        out.push_back(at + ".map: texel (" + std::to_string(bx) + ", " + std::to_string(by) + ") channel " +
+                      std::to_string(bc) + " is negative or not finite");
+      else if (!(std::abs(luminance_of(set.channels, a.map.integral() - a.flux)) <= tol(a.flux)))
+        out.push_back(at + ".flux: differs from the integral of its map");
+      if (k == 0 ? a.parent != -1 : (a.parent < 0 || std::size_t(a.parent) >= set.levels[k - 1].apls.size()))
+        out.push_back(at + ".parent: " + std::to_string(a.parent) + " is not a valid index");
+    }
+    if (k == 0) continue;
+    std::vector<glm::dvec3> child_sum(set.levels[k - 1].apls.size(), glm::dvec3(0.0));
+    for (const Apl& a : level.apls)
+      if (a.parent >= 0 && std::size_t(a.parent) < child_sum.size()) child_sum[a.parent] += a.flux;
+    for (std::size_t p = 0; p < child_sum.size(); ++p)
+      if (!(std::abs(luminance_of(set.channels, child_sum[p] - set.levels[k - 1].apls[p].flux)) <=
+            tol(set.levels[k - 1].apls[p].flux)))
+        out.push_back(where + ": children of levels[" + std::to_string(k - 1) + "].apls[" + std::to_string(p) +
+                      "] do not sum to its flux");
+  }
+  return out;
+}
+
+LUMX_NAMESPACE_END

@@ -1,0 +1,537 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// lumx/apl/error.h — how far each level of an APL set is from the rays it was built from: reference
+// evaluators on measurement spheres, error metrics, the rays' own noise floor, cost per level, and the
+// per-level error tables that the LOD error-target rule reads (apl/lod.h).
+//
+// Method (dissertation 000 §5.3, "virtual measurement spheres", Figure 5.8; seed 001 §6):
+//   - Spheres. Around the set's bounding sphere (centre c = bounds.center, diameter D = 2·bounds.radius)
+//     we place spheres of radius ρ = d·D for relative distances d (default 0.5, 0.75, 1, 2, 5, 10; d = 0.5
+//     is the bounding sphere itself, d = 5 the traditional start of the far field).
+//   - Patches. Each sphere is cut into N equal-area patches: the texels of an equal-area sphere map of
+//     resolution R_patch (math/sphere_map.h), seen from c. Every texel covers 4π/N sr, so every patch covers
+//     the area A = 4πρ²/N. R_patch = 16 gives N = 2·16² = 512.
+//   - Reference. Every ray (start p, direction ω, flux Φ) is followed to where it leaves each sphere, and
+//     Φ is added to the patch that contains the exit point's direction from c. The reference irradiance of
+//     patch i is E_ref(i) = Σ Φ / A (lx for lm, W/m² for W): flux through the patch per unit area, the
+//     histogram estimate of irradiance on the sphere (000 §5.3: "using all the particles").
+//       · Rays start inside or on the sphere for d ≥ 0.5 when the bounds hold every start point. A ray
+//         starting outside is counted (`started_outside`); it contributes at its exit point if its line
+//         crosses the sphere ahead of it, and is otherwise counted in `missed`.
+//       · The even- and odd-indexed rays (index in the stream, from 0) are also gathered apart, each half
+//         scaled by 2 so that it alone estimates E_ref; they give the noise floor below.
+//   - Model. A level's irradiance at patch i is irradiance(set, k, x, n) (apl/evaluation.h) at points
+//     x = c + ρ·u of the patch, with the normal n = −u pointing to the sphere's centre, so light leaving
+//     the luminaire outward counts with the same projected area as the reference's flux per area. The
+//     points are the centres of a k×k grid of sub-texels of patch i (k = 1: the patch centre), averaged.
+//     E_ref is a patch average, so the model's value must be one too: a point value at the centre is a
+//     one-point quadrature of it, which is fine while the maps are smoother than the patches but not
+//     when they are finer. A map of resolution 4·R_patch holding a narrow beam shows its peak at one
+//     patch's centre and nothing at its neighbours' — on the measured far-field TM-25 file the one-APL
+//     level, an exact copy of the rays' histogram, scores 209 % at k = 1 and 0 % at k = 4. So by default
+//     (patch_subsamples = 0) k is chosen per level as ⌈R_map / R_patch⌉, clamped to [1, 16] and lowered
+//     until the level's APL lookups (APLs · k² · N · spheres) stay within `max_apl_lookups`; then every
+//     map texel under a patch is sampled about once. patch_subsamples = 1 gives the plain patch-centre
+//     evaluation.
+//   - Far field. The "far field" row is level 0's summed maps, Σ_i I_i(ω) (far_field_intensity, the
+//     intensity the IES/LDT export samples), as one point at the bounding-sphere centre c:
+//     E = I(ω)·max(0, −n·ω)/r². Sets built from rays have one APL at c in level 0, so the two rows
+//     agree; they differ for sets whose level 0 is elsewhere or has several APLs.
+//
+// Metrics, per (level, d), over the N patches (E_ref = reference, E = model):
+//   relative RMSE (000 eq. 5.1)   ε = √(Σ_i (E_ref(i) − E(i))² / N) / (Σ_i E_ref(i) / N)
+//   normalised distributions      p_i = E_ref(i) / Σ_j E_ref(j),  q_i = E(i) / Σ_j E(j)   (Σ p = Σ q = 1;
+//                                 equal-area patches make these probabilities of a patch receiving light)
+//   l² distance (001 §6)          D_l²(p, q) = √(Σ_i (p_i − q_i)²)                          ∈ [0, √2]
+//   Hellinger distance (001 §6)   D_H(p, q) = √(½ Σ_i (√p_i − √q_i)²)                      ∈ [0, 1]
+//     (001 writes √(a_i/N) with a, b normalised to mean 1, i.e. a_i/N = p_i: the same number.)
+//   ε measures absolute (flux) errors relative to the mean; D_l² and D_H only the shape of the pattern.
+//   A metric is NaN when it is undefined: no patch, or a distribution with no light (Σ = 0).
+//
+// Noise floor. E_ref is itself a Monte-Carlo estimate, so even an exact model shows an error against it.
+// With the halves E_a, E_b (each an independent estimate from half of the rays, scaled by 2):
+//     noise floor = √(Σ_i (E_a(i) − E_b(i))² / N) / (Σ_i E_ref(i) / N) / 2.
+// Why 2: a half has half the rays, so its noise is √2 × the full set's; E_a − E_b is the difference of
+// two independent estimates, whose noise is √2 × a half's; together 2 × the full set's noise. The result
+// estimates the relative RMSE that a perfect model would show against E_ref. (The model's maps are built
+// from the same rays, so part of their noise is shared with E_ref: a level can measure below the floor.)
+//
+// Cost. Each level's irradiance over every patch of every sphere is timed with std::chrono (repeated
+// until `min_timing_seconds` have passed) and reported as ns per irradiance evaluation, beside the bytes
+// of its maps (AplLevel::map_bytes()).
+//
+// Determinism and memory. The rays are streamed once, in order, and summed in double: the same set,
+// rays and options give bit-identical errors (timings aside), whatever the chunk size. Memory is
+// O(spheres × N) for the reference and O(spheres × N × k²) while a level is evaluated, independent of the
+// ray count.
+#pragma once
+
+#include <lumx/apl/evaluation.h>
+#include <lumx/apl/apl_set.h>
+#include <lumx/rays/rayset.h>
+#include <lumx/math/sphere_map.h>
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+LUMX_NAMESPACE_BEGIN
+
+/// The three metrics of one model against one reference on one sphere (see the header comment).
+struct IrradianceErrors {
+  double relative_rmse = NAN;  ///< 000 eq. 5.1 (a fraction: 0.04 = 4 %)
+  double l2 = NAN;             ///< l² distance of the normalised distributions (001 §6)
+  double hellinger = NAN;      ///< Hellinger distance of the normalised distributions (001 §6)
+};
+
+/// Relative RMSE (eq. 5.1), l² and Hellinger distances of `model` against `reference`, patch by patch.
+/// Throws std::invalid_argument when the sizes differ. Undefined metrics are NaN: every metric for no
+/// patch; the relative RMSE when Σ reference = 0; l² and Hellinger when either sum is 0 or a value is
+/// negative (they compare probability distributions).
+inline IrradianceErrors compare_irradiance(const std::vector<double>& reference, const std::vector<double>& model) {
+  if (reference.size() != model.size())
+    throw std::invalid_argument("compare_irradiance: " + std::to_string(reference.size()) + " reference values, " +
+                                std::to_string(model.size()) + " model values");
+  IrradianceErrors e;
+  const std::size_t n = reference.size();
+  if (n == 0) return e;
+  double sum_ref = 0, sum_model = 0, sq = 0;
+  bool non_negative = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    sum_ref += reference[i];
+    sum_model += model[i];
+    sq += (reference[i] - model[i]) * (reference[i] - model[i]);
+    non_negative = non_negative && reference[i] >= 0 && model[i] >= 0;
+  }
+  const double mean_ref = sum_ref / double(n);
+  if (mean_ref != 0) e.relative_rmse = std::sqrt(sq / double(n)) / mean_ref;
+  if (!non_negative || !(sum_ref > 0) || !(sum_model > 0)) return e;
+  double l2 = 0, h = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double p = reference[i] / sum_ref, q = model[i] / sum_model;
+    l2 += (p - q) * (p - q);
+    h += (std::sqrt(p) - std::sqrt(q)) * (std::sqrt(p) - std::sqrt(q));
+  }
+  e.l2 = std::sqrt(l2);
+  e.hellinger = std::sqrt(0.5 * h);
+  return e;
+}
+
+/// The noise floor of a reference from its two independent halves (each scaled to estimate the whole):
+/// √(Σ (a_i − b_i)² / N) / mean((a + b)/2) / 2 — the relative RMSE of the halves against each other,
+/// over 2 (see the header comment for the factor). NaN when empty or without light; throws
+/// std::invalid_argument when the sizes differ.
+inline double noise_floor(const std::vector<double>& half_a, const std::vector<double>& half_b) {
+  if (half_a.size() != half_b.size())
+    throw std::invalid_argument("noise_floor: the halves have different sizes");
+  const std::size_t n = half_a.size();
+  if (n == 0) return NAN;
+  double sum = 0, sq = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sum += 0.5 * (half_a[i] + half_b[i]);
+    sq += (half_a[i] - half_b[i]) * (half_a[i] - half_b[i]);
+  }
+  if (!(sum > 0)) return NAN;
+  return 0.5 * std::sqrt(sq / double(n)) / (sum / double(n));
+}
+
+struct AplErrorOptions {
+  /// Relative distances d of the measurement spheres (radius d·D); sorted, positive, distinct.
+  std::vector<double> relative_distances = {0.5, 0.75, 1, 2, 5, 10};
+  /// R_patch: the patches are the texels of a sphere map of this resolution, N = 2·R² (1..1024).
+  int patch_resolution = 16;
+  /// k: a level's irradiance on a patch is the mean over k×k sub-texel centres (1 = the patch centre;
+  /// 1..16), or 0: per level, k = ⌈R_map / R_patch⌉ within [1, 16] and `max_apl_lookups` (header comment).
+  int patch_subsamples = 0;
+  /// Bound on one level's APL lookups (APLs × k² × N × spheres) when k is automatic (2·10⁸: 5–10 s at
+  /// 25–50 ns per lookup).
+  double max_apl_lookups = 2e8;
+  /// D used when the set's bounding diameter is smaller (m). A point source (every ray from one point,
+  /// D = 0) still gets spheres; its relative errors do not depend on the radius, since its pattern on
+  /// every sphere is the intensity scaled by 1/ρ².
+  double min_diameter = 1e-3;
+  std::size_t chunk_rays = 1 << 16;  ///< rays per read
+  /// The level timings repeat the patch loop until at least this long has passed (0: once).
+  double min_timing_seconds = 0.01;
+  bool far_field = true;             ///< evaluate the far-field row
+  IrradianceOptions irradiance;      ///< passed to irradiance() (minimum distance)
+  /// Called with the fraction done (0..1) and a phase ("rays", "levels"), at most a few hundred times.
+  std::function<void(double, const char*)> progress;
+};
+
+/// The measurement spheres and their patches: geometry only (no rays).
+class MeasurementSpheres {
+ public:
+  MeasurementSpheres() = default;
+  /// Throws std::invalid_argument for bad options (see AplErrorOptions) or a non-finite bound.
+  MeasurementSpheres(const BoundingSphere& bounds, const AplErrorOptions& o)
+      : centre_(bounds.center), resolution_(o.patch_resolution), subsamples_(o.patch_subsamples) {
+    if (o.relative_distances.empty()) throw std::invalid_argument("apl_error: no relative distance given");
+    distances_ = o.relative_distances;
+    std::sort(distances_.begin(), distances_.end());
+    for (std::size_t j = 0; j < distances_.size(); ++j)
+      if (!(distances_[j] > 0) || !std::isfinite(distances_[j]) || (j > 0 && distances_[j] == distances_[j - 1]))
+        throw std::invalid_argument("apl_error: relative distances must be positive, finite and distinct");
+    if (resolution_ < 1 || resolution_ > 1024)
+      throw std::invalid_argument("apl_error: patch_resolution must be in [1, 1024]");
+    if (subsamples_ < 0 || subsamples_ > 16)
+      throw std::invalid_argument("apl_error: patch_subsamples must be in [1, 16], or 0 (automatic)");
+    if (!(o.max_apl_lookups > 0)) throw std::invalid_argument("apl_error: max_apl_lookups must be positive");
+    max_lookups_ = o.max_apl_lookups;
+    if (!std::isfinite(bounds.radius) || !(bounds.radius >= 0) || !std::isfinite(bounds.center.x) ||
+        !std::isfinite(bounds.center.y) || !std::isfinite(bounds.center.z))
+      throw std::invalid_argument("apl_error: the bounding sphere is not finite");
+    if (!(o.min_diameter > 0) || !std::isfinite(o.min_diameter))
+      throw std::invalid_argument("apl_error: min_diameter must be positive");
+    diameter_ = std::max(2.0 * bounds.radius, o.min_diameter);
+  }
+
+  std::size_t sphere_count() const { return distances_.size(); }
+  /// N = 2·R_patch² patches per sphere.
+  std::size_t patch_count() const { return std::size_t(2) * std::size_t(resolution_) * std::size_t(resolution_); }
+  int patch_resolution() const { return resolution_; }
+  /// The option as given: k, or 0 for automatic (see subsamples_for).
+  int patch_subsamples() const { return subsamples_; }
+  /// k for a level of `apls` APLs with maps of resolution `map_resolution`: the option when it is fixed;
+  /// else ⌈map_resolution / R_patch⌉ within [1, 16], lowered while APLs · k² · N · spheres > max_apl_lookups.
+  int subsamples_for(int map_resolution, std::size_t apls) const {
+    if (subsamples_ > 0) return subsamples_;
+    int k = std::clamp((map_resolution + resolution_ - 1) / resolution_, 1, 16);
+    const double per_k2 = double(std::max<std::size_t>(apls, 1)) * double(patch_count()) * double(sphere_count());
+    while (k > 1 && per_k2 * k * k > max_lookups_) --k;
+    return k;
+  }
+  const std::vector<double>& relative_distances() const { return distances_; }
+  glm::dvec3 centre() const { return centre_; }
+  /// D: the bounding diameter, or min_diameter when that is larger.
+  double diameter() const { return diameter_; }
+  /// ρ = d·D of sphere s (m).
+  double radius(std::size_t s) const { return distances_.at(s) * diameter_; }
+  /// Area of one patch of sphere s: 4πρ²/N (m²).
+  double patch_area(std::size_t s) const {
+    const double r = radius(s);
+    return 4.0 * kPi * r * r / double(patch_count());
+  }
+  /// The patch (texel index y·2R + x) that contains unit direction u seen from the centre.
+  std::size_t patch_of(const glm::vec3& u) const {
+    int x, y;
+    sphere_map::texel_of(u, resolution_, x, y);
+    return std::size_t(y) * std::size_t(2 * resolution_) + std::size_t(x);
+  }
+  /// Unit directions of the evaluation points: the centres of k×k sub-texels of every patch, patch by
+  /// patch (k = 1: the patch centres).
+  std::vector<glm::dvec3> evaluation_directions(int k) const {
+    if (k < 1 || k > 16) throw std::invalid_argument("apl_error: subsamples must be in [1, 16]");
+    const int R = resolution_;
+    std::vector<glm::dvec3> out;
+    out.reserve(patch_count() * std::size_t(k * k));
+    for (int y = 0; y < R; ++y)
+      for (int x = 0; x < 2 * R; ++x)
+        for (int j = 0; j < k; ++j)
+          for (int i = 0; i < k; ++i) {
+            const float u = (float(x) + (float(i) + 0.5f) / float(k)) / float(2 * R);
+            const float v = (float(y) + (float(j) + 0.5f) / float(k)) / float(R);
+            out.push_back(glm::normalize(glm::dvec3(sphere_map::uv_to_direction({u, v}))));
+          }
+    return out;
+  }
+
+ private:
+  glm::dvec3 centre_{0.0};
+  double diameter_ = 0;
+  int resolution_ = 0, subsamples_ = 0;
+  double max_lookups_ = 2e8;
+  std::vector<double> distances_;
+};
+
+/// The reference irradiance on one sphere.
+struct SphereReference {
+  double relative_distance = 0;     ///< d
+  double radius = 0;                ///< ρ = d·D, m
+  double patch_area = 0;            ///< 4πρ²/N, m²
+  std::vector<double> irradiance;   ///< E_ref per patch: Σ Φ / A (lx or W/m²)
+  std::vector<double> half_even;    ///< from even-indexed rays only, × 2
+  std::vector<double> half_odd;     ///< from odd-indexed rays only, × 2
+  double flux = 0;                  ///< Σ Φ gathered on this sphere (lm or W)
+  std::uint64_t rays = 0;           ///< rays gathered (flux > 0)
+  std::uint64_t started_outside = 0;  ///< rays (flux > 0) whose start point lies outside this sphere
+  std::uint64_t missed = 0;         ///< of those, rays whose line never leaves the sphere ahead of them
+  double noise_floor = NAN;         ///< noise_floor(half_even, half_odd)
+};
+
+/// The reference of every sphere, from one pass over a rayset.
+struct ReferenceIrradiance {
+  MeasurementSpheres spheres;
+  std::vector<SphereReference> sphere;  ///< one per relative distance, increasing
+  PhotometricQuantity quantity = PhotometricQuantity::photometric;
+  std::uint64_t rays = 0;               ///< rays streamed
+  std::uint64_t zero_flux_rays = 0;
+  double flux = 0;                      ///< Σ Φ of every ray (lm or W)
+};
+
+/// Streams `rays` once (rewinding first) and gathers the reference irradiance on the spheres around
+/// `bounds`. Throws std::invalid_argument for bad options, or for a ray with a non-finite position or
+/// direction, a zero direction, or a negative or non-finite flux (the ray's index in the message).
+inline ReferenceIrradiance gather_reference(RaySource& rays, const BoundingSphere& bounds,
+                                            const AplErrorOptions& options = {}) {
+  ReferenceIrradiance ref;
+  ref.spheres = MeasurementSpheres(bounds, options);
+  ref.quantity = rays.info().quantity;
+  const MeasurementSpheres& ms = ref.spheres;
+  const std::size_t ns = ms.sphere_count(), np = ms.patch_count();
+  // Per sphere, flux sums of the even and odd rays (the full sum is their sum).
+  std::vector<std::vector<double>> even(ns, std::vector<double>(np, 0.0)), odd = even;
+  std::vector<double> radius2(ns);
+  ref.sphere.resize(ns);
+  for (std::size_t s = 0; s < ns; ++s) {
+    ref.sphere[s].relative_distance = ms.relative_distances()[s];
+    ref.sphere[s].radius = ms.radius(s);
+    ref.sphere[s].patch_area = ms.patch_area(s);
+    radius2[s] = ms.radius(s) * ms.radius(s);
+  }
+  const glm::dvec3 c = ms.centre();
+  const std::uint64_t expected = rays.info().ray_count;
+  RayChunk chunk;
+  rays.rewind();
+  std::uint64_t index = 0;
+  int reported = -1;
+  while (rays.next(chunk, std::max<std::size_t>(1, options.chunk_rays))) {
+    for (std::size_t i = 0; i < chunk.size(); ++i, ++index) {
+      const double flux = chunk.flux[i];
+      const glm::dvec3 o = glm::dvec3(chunk.position(i)) - c;
+      const glm::dvec3 w(chunk.direction(i));
+      const double a = glm::dot(w, w);
+      if (!(flux >= 0) || !std::isfinite(flux) || !std::isfinite(o.x + o.y + o.z) || !std::isfinite(a) || !(a > 0))
+        throw std::invalid_argument("apl_error: ray " + std::to_string(index) +
+                                    " has a non-finite position, a zero or non-finite direction, or a negative or "
+                                    "non-finite flux");
+      if (flux == 0) {
+        ++ref.zero_flux_rays;
+        continue;
+      }
+      ref.flux += flux;
+      // |o + tω|² = ρ²  ⇔  a t² + 2 b t + (|o|² − ρ²) = 0; the exit is the larger root.
+      const double b = glm::dot(o, w), oo = glm::dot(o, o);
+      for (std::size_t s = 0; s < ns; ++s) {
+        SphereReference& sr = ref.sphere[s];
+        const double cc = oo - radius2[s];
+        const double disc = b * b - a * cc;
+        if (cc > 0) {  // starts outside: only the exit of a crossing ahead counts
+          ++sr.started_outside;
+          if (disc < 0 || -b + std::sqrt(disc) <= 0) {
+            ++sr.missed;
+            continue;
+          }
+        }
+        const double t = (-b + std::sqrt(std::max(0.0, disc))) / a;
+        const glm::dvec3 h = o + t * w;
+        const double len = glm::length(h);
+        // On the sphere |h| = ρ > 0; guard anyway so a degenerate case lands in a fixed patch.
+        const glm::vec3 u = len > 0 ? glm::vec3(h / len) : glm::vec3(0, 0, 1);
+        const std::size_t p = ms.patch_of(u);
+        (index % 2 == 0 ? even : odd)[s][p] += flux;
+        sr.flux += flux;
+        ++sr.rays;
+      }
+    }
+    if (options.progress && expected > 0) {
+      const int pct = int(100.0 * double(index) / double(expected));
+      if (pct != reported) {
+        options.progress(std::min(1.0, double(index) / double(expected)), "rays");
+        reported = pct;
+      }
+    }
+  }
+  ref.rays = index;
+  for (std::size_t s = 0; s < ns; ++s) {
+    SphereReference& sr = ref.sphere[s];
+    const double inv_area = 1.0 / sr.patch_area;
+    sr.irradiance.resize(np);
+    sr.half_even.resize(np);
+    sr.half_odd.resize(np);
+    for (std::size_t p = 0; p < np; ++p) {
+      sr.irradiance[p] = (even[s][p] + odd[s][p]) * inv_area;
+      sr.half_even[p] = 2.0 * even[s][p] * inv_area;
+      sr.half_odd[p] = 2.0 * odd[s][p] * inv_area;
+    }
+    sr.noise_floor = noise_floor(sr.half_even, sr.half_odd);
+  }
+  return ref;
+}
+
+/// One row of the evaluation: a level (or the far field) against the reference on every sphere.
+struct LevelErrors {
+  int level = -1;                        ///< index in AplSet::levels; −1 for the far field
+  std::size_t apls = 0;                  ///< APLs evaluated per point
+  int map_resolution = 0;                ///< R of the level's maps
+  int subsamples = 1;                    ///< k: k×k evaluation points per patch
+  std::vector<IrradianceErrors> errors;  ///< one per sphere (increasing d)
+  std::vector<std::vector<double>> irradiance;  ///< per sphere, the model's E per patch
+  double ns_per_evaluation = NAN;        ///< mean time of one irradiance evaluation (ns)
+  std::size_t bytes = 0;                 ///< AplLevel::map_bytes() (for the far field: level 0's)
+  std::size_t clamped = 0;               ///< APL distances clamped to the minimum (IrradianceResult::clamped)
+};
+
+namespace detail {
+
+/// Evaluates `point_irradiance(x, n, clamped)` (a scalar; `clamped` counts clamped distances, null in the
+/// timing repeats) at every evaluation point of every sphere, averages the subsamples per patch, compares,
+/// and times the loop.
+template <class PointIrradiance>
+void evaluate_rows(const ReferenceIrradiance& ref, const AplErrorOptions& o, LevelErrors& row,
+                   PointIrradiance&& point_irradiance) {
+  const MeasurementSpheres& ms = ref.spheres;
+  const std::size_t ns = ms.sphere_count(), np = ms.patch_count();
+  row.subsamples = ms.subsamples_for(row.map_resolution, row.apls);
+  const std::size_t k2 = std::size_t(row.subsamples) * std::size_t(row.subsamples);
+  const std::vector<glm::dvec3> dirs = ms.evaluation_directions(row.subsamples);
+  // Points and normals in float, as irradiance() takes them, computed before the clock starts.
+  std::vector<glm::vec3> xs(ns * dirs.size()), normals(dirs.size());
+  for (std::size_t e = 0; e < dirs.size(); ++e) normals[e] = glm::vec3(-dirs[e]);
+  for (std::size_t s = 0; s < ns; ++s)
+    for (std::size_t e = 0; e < dirs.size(); ++e) xs[s * dirs.size() + e] = glm::vec3(ms.centre() + ms.radius(s) * dirs[e]);
+  std::vector<double> values(xs.size());
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  std::size_t clamped = 0;
+  for (std::size_t i = 0; i < xs.size(); ++i) values[i] = point_irradiance(xs[i], normals[i % dirs.size()], &clamped);
+  double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  std::size_t passes = 1;
+  volatile double sink = 0;
+  while (seconds < o.min_timing_seconds && passes < 100000 && !xs.empty()) {
+    const auto t1 = Clock::now();
+    double s = 0;
+    for (std::size_t i = 0; i < xs.size(); ++i) s += point_irradiance(xs[i], normals[i % dirs.size()], nullptr);
+    sink = sink + s;
+    seconds += std::chrono::duration<double>(Clock::now() - t1).count();
+    ++passes;
+  }
+  row.clamped = clamped;
+  row.ns_per_evaluation = xs.empty() ? NAN : 1e9 * seconds / (double(passes) * double(xs.size()));
+  row.irradiance.assign(ns, std::vector<double>(np, 0.0));
+  row.errors.resize(ns);
+  for (std::size_t s = 0; s < ns; ++s) {
+    for (std::size_t p = 0; p < np; ++p) {
+      double sum = 0;
+      for (std::size_t j = 0; j < k2; ++j) sum += values[s * dirs.size() + p * k2 + j];
+      row.irradiance[s][p] = sum / double(k2);
+    }
+    row.errors[s] = compare_irradiance(ref.sphere[s].irradiance, row.irradiance[s]);
+  }
+}
+
+}  // namespace detail
+
+/// Level `k` of `set` against the reference: errors per sphere, time per evaluation, bytes. The set's
+/// bounding sphere should be the one the reference was gathered around (evaluate_apl_errors does that).
+inline LevelErrors evaluate_level(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref,
+                                  const AplErrorOptions& options = {}) {
+  const AplLevel& level = set.levels.at(k);
+  LevelErrors row;
+  row.level = int(k);
+  row.apls = level.size();
+  row.map_resolution = level.map_resolution;
+  row.bytes = level.map_bytes();
+  detail::evaluate_rows(ref, options, row, [&](const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
+    const IrradianceResult r = irradiance(set, k, x, n, options.irradiance);
+    if (clamped) *clamped += r.clamped;
+    return luminance_of(set.channels, r.irradiance);
+  });
+  return row;
+}
+
+/// Irradiance at x (normal n) from level 0's far-field intensity Σ_i I_i(ω) placed at the bounding-sphere
+/// centre (the "far field" row; see the header comment). Throws std::out_of_range without levels.
+inline double far_field_irradiance(const AplSet& set, const glm::vec3& x, const glm::vec3& n,
+                                   const IrradianceOptions& options = {}, std::size_t* clamped = nullptr) {
+  const AplLevel& level = set.levels.at(0);
+  const glm::vec3 d = x - glm::vec3(set.bounds.center);
+  float r2 = glm::dot(d, d);
+  const float r = std::sqrt(r2);
+  const glm::vec3 w = r > 0 ? d * (1.0f / r) : glm::vec3(0, 0, -1);
+  const float min_r = float(detail::effective_min_distance(set, options));
+  if (r < min_r) {
+    r2 = min_r * min_r;
+    if (clamped) ++*clamped;
+  }
+  const float cosine = options.ignore_normal ? 1.0f : -glm::dot(n, w);
+  if (cosine <= 0.0f) return 0.0;
+  return luminance_of(set.channels, far_field_intensity(level, w)) * double(cosine) / double(r2);
+}
+
+/// The far-field row against the reference.
+inline LevelErrors evaluate_far_field(const AplSet& set, const ReferenceIrradiance& ref,
+                                      const AplErrorOptions& options = {}) {
+  const AplLevel& level = set.levels.at(0);
+  LevelErrors row;
+  row.level = -1;
+  row.apls = 1;
+  row.map_resolution = level.map_resolution;
+  row.bytes = level.map_bytes();
+  detail::evaluate_rows(ref, options, row, [&](const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
+    return far_field_irradiance(set, x, n, options.irradiance, clamped);
+  });
+  return row;
+}
+
+/// Everything `lumx eval --rays` reports.
+struct AplErrorReport {
+  ReferenceIrradiance reference;
+  std::vector<LevelErrors> levels;  ///< one per set level, in order
+  LevelErrors far_field;            ///< level == −1; empty errors when AplErrorOptions::far_field is off
+};
+
+/// Gathers the reference from `rays` (one pass) around `set.bounds` and evaluates every level and the far
+/// field. Throws std::invalid_argument for a set without levels, bad options or a bad ray.
+inline AplErrorReport evaluate_apl_errors(const AplSet& set, RaySource& rays, const AplErrorOptions& options = {}) {
+  if (set.levels.empty()) throw std::invalid_argument("apl_error: the set has no level");
+  AplErrorReport report;
+  report.reference = gather_reference(rays, set.bounds, options);
+  const std::size_t rows = set.levels.size() + (options.far_field ? 1 : 0);
+  for (std::size_t k = 0; k < set.levels.size(); ++k) {
+    report.levels.push_back(evaluate_level(set, k, report.reference, options));
+    if (options.progress) options.progress(double(k + 1) / double(rows), "levels");
+  }
+  if (options.far_field) {
+    report.far_field = evaluate_far_field(set, report.reference, options);
+    if (options.progress) options.progress(1.0, "levels");
+  }
+  return report;
+}
+
+/// A level's error table from its row: (d, relative RMSE) for every sphere where the error is defined.
+inline ErrorTable error_table(const LevelErrors& row, const ReferenceIrradiance& ref) {
+  ErrorTable t;
+  for (std::size_t s = 0; s < row.errors.size() && s < ref.sphere.size(); ++s) {
+    const double e = row.errors[s].relative_rmse;
+    if (!std::isfinite(e) || e < 0) continue;
+    t.relative_distance.push_back(ref.sphere[s].relative_distance);
+    t.relative_rmse.push_back(e);
+  }
+  return t;
+}
+
+/// Fills AplLevel::error of every level of `set` from `report` (which must have been made from this set:
+/// same level count and APL counts, else std::invalid_argument), so write_bundle stores the tables and
+/// choose_level_for_error (apl/lod.h) can use them.
+inline void store_error_tables(AplSet& set, const AplErrorReport& report) {
+  if (report.levels.size() != set.levels.size())
+    throw std::invalid_argument("store_error_tables: the report has " + std::to_string(report.levels.size()) +
+                                " levels, the set " + std::to_string(set.levels.size()));
+  for (std::size_t k = 0; k < set.levels.size(); ++k)
+    if (report.levels[k].level != int(k) || report.levels[k].apls != set.levels[k].size())
+      throw std::invalid_argument("store_error_tables: level " + std::to_string(k) +
+                                  " of the report does not match the set's");
+  for (std::size_t k = 0; k < set.levels.size(); ++k)
+    set.levels[k].error = error_table(report.levels[k], report.reference);
+}
+
+LUMX_NAMESPACE_END

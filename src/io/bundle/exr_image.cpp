@@ -1,0 +1,169 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// src/io/bundle/exr_image.cpp — OpenEXR through in-memory streams.
+#include "io/bundle/exr_image.h"
+
+#include <lumx/core/diagnostic.h>
+
+#include <ImfChannelList.h>
+#include <ImfCompression.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <Iex.h>
+#include <half.h>
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+
+LUMX_NAMESPACE_BEGIN
+namespace detail {
+namespace {
+
+class StringOStream : public Imf::OStream {
+ public:
+  StringOStream() : Imf::OStream("<memory>") {}
+  void write(const char c[], int n) override {
+    const std::size_t end = position_ + std::size_t(n);
+    if (end > bytes_.size()) bytes_.resize(end);
+    std::memcpy(&bytes_[position_], c, std::size_t(n));
+    position_ = end;
+  }
+  uint64_t tellp() override { return position_; }
+  void seekp(uint64_t pos) override { position_ = std::size_t(pos); }
+  std::string take() { return std::move(bytes_); }
+
+ private:
+  std::string bytes_;
+  std::size_t position_ = 0;
+};
+
+class MemoryIStream : public Imf::IStream {
+ public:
+  MemoryIStream(std::string_view bytes, const std::string& name) : Imf::IStream(name.c_str()), bytes_(bytes) {}
+  bool read(char c[], int n) override {
+    if (n < 0 || position_ + std::size_t(n) > bytes_.size())
+      throw Iex::InputExc("unexpected end of file");
+    std::memcpy(c, bytes_.data() + position_, std::size_t(n));
+    position_ += std::size_t(n);
+    return position_ < bytes_.size();
+  }
+  uint64_t tellg() override { return position_; }
+  void seekg(uint64_t pos) override { position_ = std::size_t(std::min<uint64_t>(pos, bytes_.size())); }
+
+ private:
+  std::string_view bytes_;
+  std::size_t position_ = 0;
+};
+
+[[noreturn]] void fail(const std::string& file, const std::string& field, const std::string& message) {
+  throw_at_field(file, field, message);
+}
+
+}  // namespace
+
+std::string encode_exr(const ExrImage& image) {
+  const std::size_t nc = image.channels.size();
+  if (image.pixels.size() != std::size_t(image.width) * std::size_t(image.height) * nc)
+    throw std::logic_error("encode_exr: pixel count does not match the image size");
+  Imf::Header header(image.width, image.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  const Imf::PixelType type = image.half ? Imf::HALF : Imf::FLOAT;
+  // OpenEXR writes a channel from a slice of the same type: round to half here (round-to-nearest-even,
+  // Imath::half; callers have checked the range, so nothing becomes Inf).
+  std::vector<Imath::half> halves;
+  if (image.half) halves.assign(image.pixels.begin(), image.pixels.end());
+  const std::size_t bytes = image.half ? sizeof(Imath::half) : sizeof(float);
+  char* base = image.half ? (char*)halves.data() : (char*)image.pixels.data();
+  Imf::FrameBuffer frame;
+  for (std::size_t c = 0; c < nc; ++c) {
+    header.channels().insert(image.channels[c], Imf::Channel(type));
+    frame.insert(image.channels[c], Imf::Slice(type, base + c * bytes, bytes * nc, bytes * nc * std::size_t(image.width)));
+  }
+  StringOStream out;
+  {
+    Imf::OutputFile file(out, header);
+    file.setFrameBuffer(frame);
+    file.writePixels(image.height);
+  }
+  return out.take();
+}
+
+struct ExrReader::Impl {
+  MemoryIStream stream;
+  Imf::InputFile file;
+  Impl(std::string_view bytes, const std::string& name) : stream(bytes, name), file(stream) {}
+};
+
+ExrReader::ExrReader(std::string_view bytes, const std::string& file, int width, int height,
+                     const std::vector<std::string>& channels)
+    : impl_(nullptr), file_(file), width_(width), height_(height), channels_(channels) {
+  try {
+    impl_ = new Impl(bytes, file);
+    const Imf::Header& header = impl_->file.header();
+    const Imath::Box2i window = header.dataWindow();
+    const long long w = (long long)window.max.x - window.min.x + 1;
+    const long long h = (long long)window.max.y - window.min.y + 1;
+    if (window.min.x != 0 || window.min.y != 0) fail(file, "dataWindow", "does not start at (0, 0)");
+    if (w != width || h != height)
+      fail(file, "dataWindow", "image is " + std::to_string(w) + " × " + std::to_string(h) + ", the manifest says " +
+                                   std::to_string(width) + " × " + std::to_string(height));
+    std::size_t found = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      if (std::find(channels.begin(), channels.end(), std::string(it.name())) == channels.end())
+        fail(file, "channels", std::string("unexpected channel \"") + it.name() + "\"");
+      if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
+        fail(file, "channels", std::string("channel \"") + it.name() + "\" is subsampled");
+      half_ = half_ && it.channel().type == Imf::HALF;
+      ++found;
+    }
+    if (found != channels.size())
+      fail(file, "channels", "has " + std::to_string(found) + " channels, expected " + std::to_string(channels.size()));
+  } catch (const Error&) {
+    delete impl_;
+    throw;
+  } catch (const std::exception& e) {
+    delete impl_;
+    fail(file, "OpenEXR", e.what());
+  }
+}
+
+ExrReader::~ExrReader() { delete impl_; }
+
+void ExrReader::read_rows(int y0, int y1, float* out) {
+  if (y0 < 0 || y1 < y0 || y1 >= height_) throw std::logic_error("ExrReader::read_rows: rows out of range");
+  try {
+    const std::size_t nc = channels_.size();
+    // OpenEXR addresses a slice by absolute (x, y); Slice::Make places `out` at the origin (0, y0).
+    const std::size_t row = nc * std::size_t(width_);
+    Imf::FrameBuffer frame;
+    for (std::size_t c = 0; c < nc; ++c)
+      frame.insert(channels_[c], Imf::Slice::Make(Imf::FLOAT, out + c, Imath::V2i(0, y0), width_, y1 - y0 + 1,
+                                                  sizeof(float) * nc, sizeof(float) * row));
+    impl_->file.setFrameBuffer(frame);
+    impl_->file.readPixels(y0, y1);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(file_, "OpenEXR", e.what());
+  }
+}
+
+ExrImage decode_exr(std::string_view bytes, const std::string& file, int width, int height,
+                    const std::vector<std::string>& channels) {
+  ExrReader reader(bytes, file, width, height, channels);
+  ExrImage image;
+  image.width = width;
+  image.height = height;
+  image.channels = channels;
+  image.half = reader.half();
+  image.pixels.assign(std::size_t(width) * std::size_t(height) * channels.size(), 0.0f);
+  reader.read_rows(0, height - 1, image.pixels.data());
+  return image;
+}
+
+}  // namespace detail
+LUMX_NAMESPACE_END
