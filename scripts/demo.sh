@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # Copyright Contributors to the lumx project.
-# README command 1: build everything, then run the main job on the bundled samples, all into out/demo/:
-#  1. the measured OSRAM LED rayset (TM-25) -> a lumx bundle: APL levels by clustering, each level's error
-#     against the rays, the far field; prints the speed-against-error table, writes its plots;
+# README command 1: build everything, then run the main job on what lumx generates itself (no data from
+# elsewhere is needed), all into out/demo/:
+#  1. a procedural 8-die LED strip written as a TM-25 rayset (samples/led_strip_rays.cpp) -> a lumx
+#     bundle: APL levels by clustering, each level's error against the rays, the far field; prints the
+#     speed-against-error table, writes its plots;
 #  2. far-field photometry (info, check, IES -> LDT -> IES, polar plot);
 #  3. the ring-luminaire embedding example (APL set + radiance volume by hand, partial loading).
 set -euo pipefail
@@ -13,15 +15,17 @@ lumx="$dir/converters/lumx"
 sample=samples/downlight.ies
 out=out/demo
 mkdir -p "$out"
-rays=samples/osram_lertduw_blue_100k.tm25ray
+rays=$out/led_strip.tm25ray
+echo "== samples/led_strip_rays.cpp writes a synthetic LED strip's rays -> $rays"
+"$dir/samples/led_strip_rays" "$rays" --rays 200000 --seed 1
 echo "== lumx info $rays"
 "$lumx" info "$rays"
-echo "== lumx build $rays -> $out/led.lumx (APL levels, error tables, far field)"
-rm -rf "$out/led.lumx"
-"$lumx" build "$rays" "$out/led.lumx" | tee "$out/led_build.txt"
-"$lumx" check "$out/led.lumx"
-"$lumx" eval "$out/led.lumx" --rays "$rays" --plots "$out/led_plots" > "$out/led_eval.txt"
-echo "(error-against-distance, -time and -bytes plots in $out/led_plots)"
+echo "== lumx build $rays -> $out/strip.lumx (APL levels, error tables, far field)"
+rm -rf "$out/strip.lumx"
+"$lumx" build "$rays" "$out/strip.lumx" | tee "$out/strip_build.txt"
+"$lumx" check "$out/strip.lumx"
+"$lumx" eval "$out/strip.lumx" --rays "$rays" --plots "$out/strip_plots" > "$out/strip_eval.txt"
+echo "(error-against-distance, -time and -bytes plots in $out/strip_plots)"
 echo "== lumx info $sample"
 "$lumx" info "$sample" | tee "$out/info.txt"
 "$lumx" info --json "$sample" > "$out/info.json"

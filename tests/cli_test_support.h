@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// Running the lumx command-line tool from tests, as a user would (popen of LUMX_CLI_PATH).
+// Running the lumx command-line tool and the sample programs from tests, as a user would (popen).
 #pragma once
 
 #include <array>
@@ -17,9 +17,9 @@ struct CliRun {
   std::string out;  ///< stdout, and stderr when merged
 };
 
-/// Runs `lumx ARGS`; stderr is merged into `out` unless `stderr_too` is false (then discarded).
-inline CliRun run_cli(const std::string& args, bool stderr_too = true) {
-  const std::string cmd = std::string("\"") + LUMX_CLI_PATH + "\" " + args + (stderr_too ? " 2>&1" : " 2>/dev/null");
+/// Runs `PROGRAM ARGS`; stderr is merged into `out` unless `stderr_too` is false (then discarded).
+inline CliRun run_program(const std::string& program, const std::string& args, bool stderr_too = true) {
+  const std::string cmd = "\"" + program + "\" " + args + (stderr_too ? " 2>&1" : " 2>/dev/null");
   CliRun r;
   FILE* f = popen(cmd.c_str(), "r");
   if (!f) return r;
@@ -30,6 +30,9 @@ inline CliRun run_cli(const std::string& args, bool stderr_too = true) {
   r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   return r;
 }
+
+/// Runs `lumx ARGS` (see run_program).
+inline CliRun run_cli(const std::string& args, bool stderr_too = true) { return run_program(LUMX_CLI_PATH, args, stderr_too); }
 
 /// A path in double quotes, for a shell command line.
 inline std::string quoted(const std::filesystem::path& p) { return "\"" + p.string() + "\""; }

@@ -61,14 +61,20 @@ TEST(Cli, UsageErrorsGoToStderrWithNonZeroStatus) {
   EXPECT_NE(unknown.status, 0);
 }
 
+/// An IES file with a junk line where the lamp line belongs (line 3), as some real files have.
+fs::path junk_ies(const fs::path& dir) {
+  const fs::path p = dir / "junk_line.ies";
+  std::ofstream(p) << "IESNA:LM-63-2002\nTILT=NONE\nfile format error\n1 1000 1 3 1 1 2 0 0 0\n1 1 10\n0 45 90\n0\n100 50 0\n";
+  return p;
+}
+
 TEST(Cli, MissingAndBadFiles) {
   const CliRun m = run("info /nonexistent/lumx.ies");
   EXPECT_EQ(m.status, 1);
   EXPECT_NE(m.out.find("/nonexistent/lumx.ies"), std::string::npos);
-  const fs::path bad = fs::path(LUMX_TEST_DATA_DIR) / "photometry/NVIDIA+MDL-SDK/test_file_format_error.ies";
-  const CliRun b = run("check " + q(bad));
+  const CliRun b = run("check " + q(junk_ies(scratch("bad"))));
   EXPECT_EQ(b.status, 1);
-  EXPECT_NE(b.out.find("test_file_format_error.ies:3: error: number of lamps:"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("junk_line.ies:3: error: number of lamps:"), std::string::npos) << b.out;
 }
 
 TEST(Cli, InfoTextAndJson) {
@@ -87,7 +93,7 @@ TEST(Cli, InfoTextAndJson) {
 
 TEST(Cli, CheckClassifiesEveryRealFile) {
   const auto files = lumx_test::shared_photometry_files({".ies", ".ldt"});
-  if (files.empty()) GTEST_SKIP() << "../shared not present";
+  if (files.empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   std::string args = "check --json";
   for (const auto& f : files) args += " " + q(f);
   const CliRun r = run(args, false);
@@ -130,7 +136,7 @@ TEST(Cli, FailedConvertLeavesThePreviousFile) {
   const fs::path out = d / "keep.ies";
   ASSERT_EQ(run("convert " + q(kSample) + " " + q(out)).status, 0);
   const std::string before = lumx_test::read_text(out);
-  const fs::path bad = fs::path(LUMX_TEST_DATA_DIR) / "photometry/NVIDIA+MDL-SDK/test_file_format_error.ies";
+  const fs::path bad = junk_ies(scratch("keep_bad"));
   EXPECT_EQ(run("convert " + q(bad) + " " + q(out)).status, 1);
   EXPECT_EQ(lumx_test::read_text(out), before);
   for (const auto& e : fs::directory_iterator(d))

@@ -33,7 +33,7 @@ bool has(const std::string& s, const std::string& part) {
 
 TEST(CliRays, InfoSummarisesARealTm25File) {
   const fs::path f = lumx_rays::real_file("rayfile_LERTDUW_S2WP_blue_100k_20161013_IES_TM25.TM25RAY");
-  if (f.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (f.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   const CliRun r = run("info " + q(f));
   EXPECT_EQ(r.status, 0) << r.out;
   for (const char* part : {"format:        TM-25 2013", "rays:          100000", "the header states 1.68 W",
@@ -59,7 +59,7 @@ TEST(CliRays, InfoSummarisesARealTm25File) {
 
 TEST(CliRays, InfoJsonReportsNanHeaderAsNullAndTheFluxWarning) {
   const fs::path f = lumx_rays::real_file("Cyl10k.1.tm25ray");
-  if (f.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (f.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   const CliRun j = run("info --json " + q(f), false);
   ASSERT_EQ(j.status, 0) << j.out;
   const auto doc = nlohmann::json::parse(j.out);
@@ -75,7 +75,7 @@ TEST(CliRays, InfoJsonReportsNanHeaderAsNullAndTheFluxWarning) {
 
 TEST(CliRays, CheckReportsOkWarningsAndLocatedErrors) {
   const fs::path good = lumx_rays::real_file("rayfile_LERTDUW_S2WP_green_100k_20161013_IES_TM25.TM25RAY");
-  if (good.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (good.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   const CliRun ok = run("check " + q(good));
   EXPECT_EQ(ok.status, 0);
   EXPECT_EQ(ok.out, good.string() + ": OK\n");

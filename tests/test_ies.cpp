@@ -21,13 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<fs::path> all_ies_files() {
-  auto files = lumx_test::shared_photometry_files({".ies"});
-  if (files.empty())  // outside CI without ../shared: the permissively licensed copies
-    for (const auto& e : fs::recursive_directory_iterator(lumx_test::data_dir() / "photometry"))
-      if (e.path().extension() == ".ies" || e.path().extension() == ".IES") files.push_back(e.path());
-  return files;
-}
+std::vector<fs::path> all_ies_files() { return lumx_test::shared_photometry_files({".ies"}); }
 
 bool is_intentionally_invalid(const fs::path& p) { return p.filename() == "test_file_format_error.ies"; }
 
@@ -52,6 +46,7 @@ const char* kMinimal2002 =
 }  // namespace
 
 TEST(IesRead, EveryRealFileReads) {
+  if (lumx_test::shared_dir().empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   const auto files = all_ies_files();
   ASSERT_GE(files.size(), 5u);
   std::size_t read = 0;
@@ -81,7 +76,7 @@ TEST(IesRead, FluxMatchesStatedLumensOnRealFiles) {
   // These manufacturers state lamp lumens equal to the luminaire flux (LOR 100 %): the zonal integral
   // of their tables must reproduce it to the tables' own precision (0.1 %).
   const auto root = lumx_test::shared_dir();
-  if (root.empty()) GTEST_SKIP() << "../shared not present";
+  if (root.empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   const fs::path dir = root / "data/photometry/holg+eulumdat-rs";
   for (const char* name : {"S01.01.02.354_MAXWELL-8-T4 LUXEON 5050 Square with glass-MEASURED_CIE.IES",
                            "S01.01.02.354_MAXWELL-8-T4 LUXEON 5050 Square with glass-MEASURED_IESNA.ies",
@@ -96,7 +91,7 @@ TEST(IesRead, OrientationOfTwinFilesIsAQuarterTurn) {
   // The same luminaire exported with the "CIE" and the "IESNA" C0 orientation: rotating the IESNA
   // file's C-planes by +90 degrees reproduces the CIE file exactly (the --rotate-c option).
   const auto root = lumx_test::shared_dir();
-  if (root.empty()) GTEST_SKIP() << "../shared not present";
+  if (root.empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   const fs::path dir = root / "data/photometry/holg+eulumdat-rs";
   const Photometry cie = read_photometry((dir / "S01.01.02.354_MAXWELL-8-T4 LUXEON 5050 Square with glass-MEASURED_CIE.IES").string());
   const Photometry iesna = read_photometry((dir / "S01.01.02.354_MAXWELL-8-T4 LUXEON 5050 Square with glass-MEASURED_IESNA.ies").string());
@@ -112,6 +107,7 @@ TEST(IesRead, OrientationOfTwinFilesIsAQuarterTurn) {
 }
 
 TEST(IesWrite, RoundTripReproducesTheModel) {
+  if (lumx_test::shared_dir().empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   for (const auto& f : all_ies_files()) {
     if (is_intentionally_invalid(f)) continue;
     const Photometry p = read_photometry(f.string());
@@ -279,7 +275,7 @@ TEST(IesRead, TypeAAndTypeBRoundTripThroughTypeC) {
 
 TEST(IesRead, RealTypeBFloodlightConvertsToTypeC) {
   const auto root = lumx_test::shared_dir();
-  if (root.empty()) GTEST_SKIP() << "../shared not present";
+  if (root.empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   for (const char* name : {"flood_2.1.IES", "flood_2.2.ies"}) {
     const Photometry p = read_photometry((root / "data/photometry/echowuzangye+CU-calculations-based-on-IES-file" / name).string());
     ASSERT_EQ(p.type, PhotometricType::B);
@@ -325,8 +321,9 @@ TEST(IesRead, LuminousOpeningShapes) {
 TEST(IesWrite, C90C270SymmetryKeptOrExpanded) {
   // LM-63-1995 range 90..270 kept by default (exact model round trip); expanded to 0..360 on request,
   // for readers that mishandle it. Both describe the same distribution.
-  const Photometry p = read_photometry(
-      (lumx_test::data_dir() / "photometry/dlippok+photometric-viewer/symmetry_to_c90c270.ldt").string());
+  const fs::path file = lumx_test::shared_photometry("dlippok+photometric-viewer/symmetry_to_c90c270.ldt");
+  if (file.empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
+  const Photometry p = read_photometry(file.string());
   ASSERT_EQ(p.symmetry, Symmetry::plane_c90_c270);
   const Photometry kept = read_ies(format_ies(p), "kept.ies");
   EXPECT_EQ(kept.symmetry, Symmetry::plane_c90_c270);

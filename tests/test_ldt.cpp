@@ -98,7 +98,7 @@ bool contains(const std::string& s, const std::string& sub) { return s.find(sub)
 // Real files
 
 TEST(LdtRealFiles, AllReadWithPositiveFlux) {
-  if (shared_dir().empty()) GTEST_SKIP() << "shared/ test data not found";
+  if (shared_dir().empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   const auto files = shared_photometry_files({".ldt"});
   ASSERT_GE(files.size(), 40u);  // SOURCES.md lists 40 LDT files (one is .LDT)
   for (const auto& f : files) {
@@ -125,7 +125,7 @@ TEST(LdtRealFiles, AllReadWithPositiveFlux) {
 // checked to be consistent with their header, are asserted; large disagreements elsewhere (dummy test
 // files whose header was not derived from the data, e.g. photometric-viewer's) are printed only.
 TEST(LdtRealFiles, LightOutputRatioMatchesStatedLorl) {
-  if (shared_dir().empty()) GTEST_SKIP() << "shared/ test data not found";
+  if (shared_dir().empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   int asserted = 0;
   for (const auto& f : shared_photometry_files({".ldt"})) {
     const lumx::Photometry p = lumx::read_ldt(read_text(f), f.string());
@@ -149,7 +149,7 @@ TEST(LdtRealFiles, LightOutputRatioMatchesStatedLorl) {
 }
 
 TEST(LdtRealFiles, RoundTripThroughWriter) {
-  if (shared_dir().empty()) GTEST_SKIP() << "shared/ test data not found";
+  if (shared_dir().empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   for (const auto& f : shared_photometry_files({".ldt"})) {
     SCOPED_TRACE(f.string());
     const lumx::Photometry a = lumx::read_ldt(read_text(f), f.string());
@@ -239,7 +239,7 @@ std::size_t source_plane(const RawLdt& r, double c) {
 }
 
 TEST(LdtSymmetry, ExpansionMatchesHandBuiltGrid) {
-  if (shared_dir().empty()) GTEST_SKIP() << "shared/ test data not found";
+  if (shared_dir().empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   const auto dir = shared_dir() / "data" / "photometry" / "dlippok+photometric-viewer";
   const std::map<std::string, int> files = {{"symmetry_about_vertical_axis.ldt", 1},
                                             {"symmetry_to_c0c180.ldt", 2},
@@ -296,7 +296,7 @@ TEST(LdtSymmetry, ExpansionMatchesHandBuiltGrid) {
 // (written by format_ies, read back by read_ies) within 1e-6 relative (IES candela are written with 7
 // significant digits, so each value moves by at most 5e-7 relative).
 TEST(LdtSymmetry, FluxEqualsEquivalentIesFile) {
-  if (shared_dir().empty()) GTEST_SKIP() << "shared/ test data not found";
+  if (shared_dir().empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   const auto dir = shared_dir() / "data" / "photometry" / "dlippok+photometric-viewer";
   for (const char* name : {"symmetry_about_vertical_axis.ldt", "symmetry_to_c0c180.ldt", "symmetry_to_c90c270.ldt",
                            "symmetry_to_c0c90c180c270.ldt", "no_symmetry.ldt"}) {
@@ -513,7 +513,7 @@ TEST(LdtSynthetic, WarningsForTolerableOddities) {
 }
 
 TEST(LdtRealFiles, NonEquidistantAnglesRoadLuminaire) {
-  if (shared_dir().empty()) GTEST_SKIP() << "shared/ test data not found";
+  if (shared_dir().empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");
   for (const char* dir : {"holg+eulumdat-rs", "cagrin+QLumEdit"}) {
     SCOPED_TRACE(dir);
     const auto path = shared_dir() / "data" / "photometry" / dir / "road_luminaire.ldt";

@@ -30,7 +30,7 @@ RayChunk read_all(const fs::path& p, RaysetReadOptions o = {}) {
 
 TEST(RaysetRealFiles, EveryFileMatchesAnIndependentReading) {
   const auto files = real_ray_files();
-  if (files.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (files.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   EXPECT_GE(files.size(), 13u);
   for (const auto& f : files) {
     SCOPED_TRACE(f.filename().string());
@@ -76,7 +76,7 @@ TEST(RaysetRealFiles, EveryFileMatchesAnIndependentReading) {
 
 TEST(RaysetRealFiles, ThreeRayFilesAgreeAcrossFormats) {
   const fs::path lt_bin = real_file("ThreeRays_Wavelength.1.ray");
-  if (lt_bin.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (lt_bin.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   const RayChunk ref = read_all(lt_bin);
   ASSERT_EQ(ref.size(), 3u);
   ASSERT_EQ(ref.wavelength_nm.size(), 3u);
@@ -110,7 +110,7 @@ TEST(RaysetRealFiles, ThreeRayFilesAgreeAcrossFormats) {
 
 TEST(RaysetRealFiles, Tm25HeaderTextSpectraAndFluxPolicy) {
   const fs::path blue = real_file("rayfile_LERTDUW_S2WP_blue_100k_20161013_IES_TM25.TM25RAY");
-  if (blue.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (blue.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   {
     std::vector<Diagnostic> w;
     auto src = open_collect(blue, w);
@@ -174,7 +174,7 @@ TEST(RaysetRealFiles, Tm25HeaderTextSpectraAndFluxPolicy) {
 
 TEST(RaysetRealFiles, ChunkSizesAndRewindGiveTheSameRays) {
   const fs::path f = real_file("Cyl1M_Faberge.1.tm25ray");
-  if (f.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (f.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   auto src = open_rayset(f.string());
   const RayChunk all = read_all_rays(*src, 200000);
   ASSERT_EQ(all.size(), 126281u);
@@ -213,7 +213,7 @@ TEST(RaysetRealFiles, ChunkSizesAndRewindGiveTheSameRays) {
 
 TEST(RaysetRealFiles, ZemaxTextUnitsAndWavelengths) {
   const fs::path mm = real_file("ZemaxText.txt");
-  if (mm.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (mm.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   const RayChunk a = read_all(mm);
   const RayChunk b = read_all(real_file("ZemaxWavelengthText.txt"));
   ASSERT_EQ(a.size(), 9u);
@@ -235,7 +235,7 @@ TEST(RaysetFormats, DetectionByExtensionAndContent) {
                                                          {"ThreeRays_Wavelength_ZMX.ray", RaysetFormat::zemax_binary},
                                                          {"ZemaxText.txt", RaysetFormat::zemax_text}}) {
     const fs::path p = real_file(name);
-    if (p.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+    if (p.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
     EXPECT_EQ(detect_rayset_format(p.string()), format) << name;
   }
   const fs::path d = scratch("detect");

@@ -65,7 +65,7 @@ bool reset_peak_rss() {
 
 TEST(RaysetTm25Write, RealFilesWriteThenReadAreBitExact) {
   const auto files = real_ray_files();
-  if (files.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (files.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   const fs::path d = scratch("tm25_roundtrip");
   int tested = 0;
   for (const auto& f : files) {
@@ -348,7 +348,7 @@ TEST(RaysetMemory, TwoMillionRaysStreamInBoundedMemory) {
 
 TEST(RaysetMemory, ReadSpeedOnTheLargestRealFile) {
   const auto files = real_ray_files();
-  if (files.empty()) GTEST_SKIP() << "../shared/data/raysets is not present";
+  if (files.empty()) LUMX_SKIP_WITHOUT_SHARED("data/raysets");
   const fs::path big = *std::max_element(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
     return fs::file_size(a) < fs::file_size(b);
   });

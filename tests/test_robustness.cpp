@@ -71,7 +71,7 @@ TEST(Robustness, ExternalTiltThroughASymlinkOutOfTheFolderIsRefused) {
 }
 
 TEST(Robustness, LdtWithOneGammaAngleIsALocatedError) {
-  std::string ldt = lumx_test::read_text(lumx_test::data_dir() / "photometry/Wei-Lim+lighting/ldt_min_example.ldt");
+  std::string ldt = lumx_test::read_text(lumx_test::data_dir() / "ldt/isym2_point.ldt");
   // Line 6 is Ng.
   std::size_t pos = 0;
   for (int i = 0; i < 5; ++i) pos = ldt.find('\n', pos) + 1;
@@ -125,7 +125,7 @@ TEST(Robustness, HugeFilesAreReadInMemoryBoundedByTheirSize) {
   // per-line or per-token index of the whole file (which cost ~25x the file size before).
   const std::size_t n = 7u << 20;
   std::string ies = std::string(kTable);
-  std::string ldt = lumx_test::read_text(lumx_test::data_dir() / "photometry/Wei-Lim+lighting/ldt_min_example.ldt");
+  std::string ldt = lumx_test::read_text(lumx_test::data_dir() / "ldt/isym2_point.ldt");
   ies.reserve(ies.size() + 2 * n);
   ldt.reserve(ldt.size() + 2 * n);
   for (std::size_t i = 0; i < n; ++i) {

@@ -14,11 +14,18 @@
 
 namespace lumx_test {
 
-/// tests/data in the source tree.
+/// tests/data in the source tree: only files lumx made itself (bad-input corpus, synthetic fixtures).
 inline std::filesystem::path data_dir() { return LUMX_TEST_DATA_DIR; }
 
+/// True under CI (CI=true in the environment), where ../shared is always present.
+inline bool in_ci() {
+  const char* ci = std::getenv("CI");
+  return ci && *ci && std::string(ci) != "false" && std::string(ci) != "0";
+}
+
 /// ../shared beside the repository (or $LUMX_SHARED_DIR). Empty path if absent: tests that need it
-/// call GTEST_SKIP() with a message then (outside CI only; CI always has it).
+/// use LUMX_SKIP_WITHOUT_SHARED then. Third-party files (real IES/LDT and ray files) are read there in
+/// place and never copied into the repository.
 inline std::filesystem::path shared_dir() {
   const char* env = std::getenv("LUMX_SHARED_DIR");
   std::filesystem::path p = env && *env ? env : LUMX_SHARED_DIR_DEFAULT;
@@ -41,6 +48,12 @@ inline std::vector<std::filesystem::path> shared_photometry_files(const std::vec
   return out;
 }
 
+/// shared/data/photometry/<relative>, or an empty path if ../shared is absent.
+inline std::filesystem::path shared_photometry(const std::string& relative) {
+  const auto root = shared_dir();
+  return root.empty() ? std::filesystem::path() : root / "data" / "photometry" / relative;
+}
+
 inline std::string read_text(const std::filesystem::path& p) {
   std::ifstream f(p, std::ios::binary);
   std::ostringstream ss;
@@ -49,3 +62,11 @@ inline std::string read_text(const std::filesystem::path& p) {
 }
 
 }  // namespace lumx_test
+
+/// Ends a test that needs ../shared/<what> when it is absent: a skip with a clear message on a developer's
+/// machine, a failure under CI (which always has ../shared beside the clone).
+#define LUMX_SKIP_WITHOUT_SHARED(what)                                                              \
+  do {                                                                                              \
+    if (::lumx_test::in_ci()) FAIL() << "../shared/" << (what) << " is missing, but CI always has it"; \
+    GTEST_SKIP() << "../shared/" << (what) << " is not present (real-world data is read in place there)"; \
+  } while (0)

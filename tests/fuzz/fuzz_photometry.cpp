@@ -5,7 +5,7 @@
 //
 //   cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DLUMX_BUILD_FUZZERS=ON -DLUMX_BUILD_CLI=OFF \
 //         -DLUMX_BUILD_TESTS=OFF -DLUMX_BUILD_BENCH=OFF && cmake --build build-fuzz
-//   build-fuzz/tests/fuzz/lumx_fuzz_photometry tests/data/bad tests/data/photometry/*/ -max_total_time=300
+//   build-fuzz/tests/fuzz/lumx_fuzz_photometry tests/data/bad ../shared/data/photometry/*/ -max_total_time=300
 #include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/photometry/metrics.h>
