@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// lumx/lumx.h — the whole core component (lumx::lumx) in one include: every public header, by module.
+// Embedders who want less include the module headers they use; each compiles on its own.
+#pragma once
+
+#include <lumx/version.h>
+
+#include <lumx/core/diagnostic.h>
+#include <lumx/core/units.h>
+
+#include <lumx/math/aabb.h>
+#include <lumx/math/bounding_sphere.h>
+#include <lumx/math/constants.h>
+#include <lumx/math/line_fit.h>
+#include <lumx/math/piecewise_constant_2d.h>
+#include <lumx/math/sphere_map.h>
+#include <lumx/math/sphere_map_sampler.h>
+#include <lumx/math/sphere_map_smoothing.h>
+#include <lumx/math/spherical_harmonics.h>
+
+#include <lumx/photometry/far_field_grid.h>
+#include <lumx/photometry/intensity_table.h>
+#include <lumx/photometry/metrics.h>
+#include <lumx/photometry/photometric_frame.h>
+#include <lumx/photometry/photometry.h>
+#include <lumx/photometry/polar_diagram.h>
+#include <lumx/photometry/resample.h>
+#include <lumx/photometry/symmetry.h>
+#include <lumx/photometry/validate.h>
+
+#include <lumx/rays/far_field.h>
+#include <lumx/rays/rayset.h>
+
+#include <lumx/apl/apl_set.h>
+#include <lumx/apl/builder.h>
+#include <lumx/apl/clustering.h>
+#include <lumx/apl/error.h>
+#include <lumx/apl/evaluation.h>
+#include <lumx/apl/far_field.h>
+#include <lumx/apl/lod.h>
+#include <lumx/apl/sampling.h>
+
+#include <lumx/volume/radiance_volume.h>
+
+#include <lumx/io/atomic_file.h>
+#include <lumx/io/bundle_io.h>
+#include <lumx/io/photometry_io.h>
+#include <lumx/io/rayset_io.h>
