@@ -3,7 +3,7 @@
 // lumx/io/photometry_io.h — reading and writing IES LM-63 and EULUMDAT files.
 //
 // The format layer on top of the model in lumx/photometry/photometry.h. Each format has a reader and a writer
-// (src/io/ies_reader.cpp, ies_writer.cpp, ldt_reader.cpp, ldt_writer.cpp); read_photometry() picks one by
+// (src/io/photometry/ies_reader.cpp, ies_writer.cpp, ldt_reader.cpp, ldt_writer.cpp); read_photometry() picks one by
 // file extension and falls back to sniffing the content. Readers are permissive about what real files do
 // (formats.md §1.6, §2.4) and report it as warnings; they throw lumx::Error, located by file, line and
 // field, for anything that would make the data wrong. Untrusted counts are checked against the values

@@ -5,7 +5,7 @@
 // The format layer on top of lumx/rays/rayset.h. A rayset is opened as a RaySource, which reads the file's
 // header at once (checking every count against the file size before anything is allocated from it) and
 // then hands out rays in chunks: the file is read through a bounded window (pread), never whole, so a
-// 10 M-ray file is processed in a few MiB of memory. Implementations are in src/io/tm25_reader.cpp,
+// 10 M-ray file is processed in a few MiB of memory. Implementations are in src/io/rays/tm25_reader.cpp,
 // tm25_writer.cpp, lighttools_reader.cpp, zemax_reader.cpp, plain_rays_reader.cpp and
 // rayset_registry.cpp (format choice); docs/rays.md describes the formats, units and policies.
 //
