@@ -3,6 +3,8 @@
 // converters/build_command.h — `lumx build RAYS OUT`: a rayset in, a bundle out.
 #pragma once
 
+#include <lumx/apl/builder.h>
+
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -28,5 +30,11 @@ struct BuildArgs {
 };
 
 int run_build(const BuildArgs& a);
+
+/// The builder options a bundle was made with, as the JSON `lumx build` stores in its provenance
+/// ("build_options"), and back; `lumx eval` rebuilds from half of the source rays with them.
+std::string build_options_json(const lumx::AplBuildOptions& o);
+/// Throws std::invalid_argument naming the key when the text is not such JSON.
+lumx::AplBuildOptions build_options_from_json(const std::string& text);
 
 }  // namespace lumx_cli

@@ -20,6 +20,7 @@
 #include "eval_commands.h"
 
 #include "cli_support.h"
+#include "build_command.h"
 #include "eval_plot.h"
 
 #include <lumx/apl/error.h>
@@ -40,6 +41,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <thread>
 #include <string>
 #include <utility>
 #include <vector>
@@ -180,10 +182,11 @@ std::string apl_label(const lumx::LevelErrors& row) {
   return std::to_string(row.apls) + (row.apls == 1 ? " APL" : " APLs");
 }
 
-/// The metric of one row at sphere s: 0 relative RMSE, 1 Hellinger, 2 l².
+/// The metric of one row at sphere s: 0 relative RMSE with the noise removed, 1 raw relative RMSE,
+/// 2 Hellinger, 3 l².
 double metric(const lumx::LevelErrors& row, std::size_t s, int which) {
   const lumx::IrradianceErrors& e = row.errors[s];
-  return which == 0 ? e.relative_rmse : which == 1 ? e.hellinger : e.l2;
+  return which == 0 ? e.relative_rmse_noise_removed : which == 1 ? e.relative_rmse : which == 2 ? e.hellinger : e.l2;
 }
 
 std::string table_text(const lumx::AplErrorReport& r, const std::string& bundle, const std::string& rays,
@@ -199,14 +202,20 @@ std::string table_text(const lumx::AplErrorReport& r, const std::string& bundle,
   s += buf;
   std::snprintf(buf, sizeof buf,
                 "  %llu rays, %.6g %s; spheres around (%.4g, %.4g, %.4g) m, D = %.4g m; %zu patches per sphere "
-                "(R %d), k x k points per patch\n",
+                "(R %d)\n",
                 static_cast<unsigned long long>(ref.rays), ref.flux, lumx::flux_unit(q), ms.centre().x, ms.centre().y,
                 ms.centre().z, ms.diameter(), ms.patch_count(), ms.patch_resolution());
   s += buf;
-  const char* titles[3] = {"relative RMSE (eq. 5.1), % of the mean irradiance, at relative distance d",
-                           "Hellinger distance of the normalised patch distributions, at d",
+  bool averaged = false;
+  for (const lumx::LevelErrors* row : rows) averaged = averaged || row->subsamples > 1;
+  const std::string where = averaged ? "irradiance averaged over k x k points per patch (hides texel noise)"
+                                     : "irradiance at a point (the patch centre)";
+  const std::string t0 = "relative RMSE (eq. 5.1) of " + where + ", % of the mean, at relative distance d;\n" +
+                         "rays not used to build the levels, their noise removed ('<': below what these rays resolve)";
+  const std::string t1 = "the same with the rays' noise left in, and the noise floor (what an exact model would show)";
+  const char* titles[4] = {t0.c_str(), t1.c_str(), "Hellinger distance of the normalised patch distributions, at d",
                            "l2 distance of the normalised patch distributions, at d"};
-  for (int which = 0; which < 3; ++which) {
+  for (int which = 0; which < 4; ++which) {
     s += "\n";
     s += titles[which];
     s += "\n";
@@ -218,13 +227,23 @@ std::string table_text(const lumx::AplErrorReport& r, const std::string& bundle,
     }
     if (which == 0) s += "   ns/point        bytes";
     s += "\n";
-    const double scale = which == 0 ? 100.0 : 1.0;
-    const char* fmt = which == 0 ? " %*.2f" : " %*.4f";
+    const double scale = which <= 1 ? 100.0 : 1.0;
+    const char* fmt = which <= 1 ? " %*.2f" : " %*.4f";
     for (const lumx::LevelErrors* row : rows) {
       std::snprintf(buf, sizeof buf, "%-11s %6zu %5d %3d", level_name(*row).c_str(), row->apls, row->map_resolution,
                     row->subsamples);
       s += buf;
-      for (std::size_t i = 0; i < row->errors.size(); ++i) s += format_cell(scale * metric(*row, i, which), fmt, 8);
+      for (std::size_t i = 0; i < row->errors.size(); ++i) {
+        const lumx::IrradianceErrors& e = row->errors[i];
+        if (which == 0 && std::isfinite(e.relative_rmse_noise_removed) && !e.resolved) {
+          char cell[32];
+          std::snprintf(cell, sizeof cell, "<%.2f", 100 * e.noise_removed_upper);
+          std::snprintf(buf, sizeof buf, " %8s", cell);
+          s += buf;
+        } else {
+          s += format_cell(scale * metric(*row, i, which), fmt, 8);
+        }
+      }
       if (which == 0) {
         s += format_cell(row->ns_per_evaluation, " %*.0f", 10);
         std::snprintf(buf, sizeof buf, " %12zu", row->bytes);
@@ -232,7 +251,7 @@ std::string table_text(const lumx::AplErrorReport& r, const std::string& bundle,
       }
       s += "\n";
     }
-    if (which == 0) {
+    if (which == 1) {
       std::snprintf(buf, sizeof buf, "%-11s %6s %5s %3s", "noise floor", "", "", "");
       s += buf;
       for (const auto& sr : ref.sphere) s += format_cell(100.0 * sr.noise_floor, fmt, 8);
@@ -256,9 +275,13 @@ std::string table_text(const lumx::AplErrorReport& r, const std::string& bundle,
 }
 
 json row_json(const lumx::LevelErrors& row) {
-  json rmse = json::array(), h = json::array(), l2 = json::array();
+  json rmse = json::array(), removed = json::array(), upper = json::array(), resolved = json::array(),
+       h = json::array(), l2 = json::array();
   for (const auto& e : row.errors) {
     rmse.push_back(e.relative_rmse);
+    removed.push_back(e.relative_rmse_noise_removed);
+    upper.push_back(e.noise_removed_upper);
+    resolved.push_back(e.resolved);
     h.push_back(e.hellinger);
     l2.push_back(e.l2);
   }
@@ -268,6 +291,9 @@ json row_json(const lumx::LevelErrors& row) {
             {"bytes", row.bytes},
             {"ns_per_evaluation", row.ns_per_evaluation},
             {"relative_rmse", rmse},
+            {"relative_rmse_noise_removed", removed},
+            {"noise_removed_upper", upper},
+            {"resolved", resolved},
             {"hellinger", h},
             {"l2", l2},
             {"clamped", row.clamped}};
@@ -282,6 +308,7 @@ json report_json(const lumx::AplErrorReport& r, const EvalArgs& a, lumx::Photome
     spheres.push_back({{"relative_distance", sr.relative_distance},
                        {"radius_m", sr.radius},
                        {"noise_floor", sr.noise_floor},
+                       {"split_noise_floor", sr.split_noise_floor},
                        {"rays", sr.rays},
                        {"started_outside", sr.started_outside},
                        {"missed", sr.missed}});
@@ -303,6 +330,12 @@ json report_json(const lumx::AplErrorReport& r, const EvalArgs& a, lumx::Photome
   return j;
 }
 
+/// What the plots show: the noise-removed point error, its upper bound where the rays cannot resolve it.
+double plotted(const lumx::IrradianceErrors& e) {
+  if (!std::isfinite(e.relative_rmse_noise_removed)) return e.relative_rmse;
+  return e.resolved ? e.relative_rmse_noise_removed : e.noise_removed_upper;
+}
+
 std::vector<std::string> write_plots(const lumx::AplErrorReport& r, const EvalArgs& a) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -320,14 +353,14 @@ std::vector<std::string> write_plots(const lumx::AplErrorReport& r, const EvalAr
   dist.title = "Relative RMSE against distance";
   dist.caption = caption;
   dist.x_label = "relative distance d (bounding diameters from the centre)";
-  dist.y_label = "relative RMSE (%)";
+  dist.y_label = "relative RMSE at a point, noise removed (%)";
   dist.y_display_scale = 100;
   for (std::size_t k = 0; k < r.levels.size(); ++k) {
     lumx::ChartSeries s;
     s.label = apl_label(r.levels[k]);
     s.color = int(k);
     s.x = ds;
-    for (const auto& e : r.levels[k].errors) s.y.push_back(e.relative_rmse);
+    for (const auto& e : r.levels[k].errors) s.y.push_back(plotted(e));
     dist.series.push_back(s);
   }
   if (!r.far_field.errors.empty()) {
@@ -336,7 +369,7 @@ std::vector<std::string> write_plots(const lumx::AplErrorReport& r, const EvalAr
     s.color = 9;
     s.dashed = true;
     s.x = ds;
-    for (const auto& e : r.far_field.errors) s.y.push_back(e.relative_rmse);
+    for (const auto& e : r.far_field.errors) s.y.push_back(plotted(e));
     dist.series.push_back(s);
   }
   lumx::ChartSeries noise;
@@ -365,7 +398,7 @@ std::vector<std::string> write_plots(const lumx::AplErrorReport& r, const EvalAr
       series.color = int(s);
       for (const auto& l : r.levels) {
         series.x.push_back(which == 0 ? l.ns_per_evaluation : double(l.bytes));
-        series.y.push_back(l.errors[s].relative_rmse);
+        series.y.push_back(plotted(l.errors[s]));
       }
       c.series.push_back(series);
     }
@@ -376,7 +409,7 @@ std::vector<std::string> write_plots(const lumx::AplErrorReport& r, const EvalAr
         ff.color = int(s);
         ff.line = false;
         ff.x.push_back(which == 0 ? r.far_field.ns_per_evaluation : double(r.far_field.bytes));
-        ff.y.push_back(r.far_field.errors[s].relative_rmse);
+        ff.y.push_back(plotted(r.far_field.errors[s]));
         c.series.push_back(ff);
       }
       lumx::ChartSeries key;
@@ -440,12 +473,38 @@ int run_rays(const EvalArgs& a) {
       std::fprintf(stderr, "\r%-8s %3d %%", phase, int(std::lround(100 * f)));
       std::fflush(stderr);
     };
-  const lumx::AplErrorReport report = lumx::evaluate_apl_errors(set, *rays, o);
+  // Grading a set on the rays it was built from would share their noise and flatter it. When the rays are
+  // the bundle's source (its provenance names them and their count), the levels are rebuilt the same way
+  // from the even rays and graded on the odd ones; --independent grades the bundle itself.
+  const auto source = set.provenance.find("source"), count = set.provenance.find("source_rays");
+  const bool is_source =
+      source != set.provenance.end() && count != set.provenance.end() &&
+      std::filesystem::path(source->second).filename() == std::filesystem::path(a.rays).filename() &&
+      count->second == std::to_string(rays->info().ray_count);
+  lumx::AplErrorReport report;
+  std::string graded = a.bundle, against = a.rays;
+  if (is_source && !a.independent) {
+    const auto opts = set.provenance.find("build_options");
+    if (opts == set.provenance.end())
+      lumx::throw_at_field(a.rays, "rays",
+                           "these are the rays the bundle was built from and it does not record its build options: "
+                           "give rays from another run, or --independent to grade it on its own rays anyway");
+    lumx::AplBuildOptions bo = build_options_from_json(opts->second);
+    bo.threads = std::max(1u, std::thread::hardware_concurrency());
+    std::fprintf(stderr, "%s: note: these rays built the bundle; its levels are rebuilt from the even rays and graded "
+                         "on the odd ones\n", a.rays.c_str());
+    report = lumx::evaluate_held_out(*rays, [&](lumx::RaySource& train) { return lumx::build_apl_set(train, bo); }, o);
+    graded += " (its levels rebuilt from the even rays)";
+    against += " (the odd rays)";
+  } else {
+    report = lumx::evaluate_apl_errors(set, *rays, o);
+    if (is_source) against += " (the rays it was built from: errors shared with them cancel)";
+  }
   if (tty) std::fputs("\r              \r", stderr);
   if (a.json) {
     std::printf("%s\n", report_json(report, a, set.quantity).dump(1).c_str());
   } else {
-    std::fputs(table_text(report, a.bundle, a.rays, set.quantity).c_str(), stdout);
+    std::fputs(table_text(report, graded, against, set.quantity).c_str(), stdout);
   }
   if (!a.plots_dir.empty()) {
     const std::vector<std::string> files = write_plots(report, a);

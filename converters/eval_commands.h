@@ -22,12 +22,13 @@ struct EvalArgs {
   // --rays mode
   std::string rays;          ///< rayset to compare against
   int patch_resolution = 16; ///< --patches R: N = 2R² patches per sphere
-  int subsamples = 0;        ///< --subsamples k: k×k evaluation points per patch (0: per level, automatic)
+  int subsamples = 1;        ///< --subsamples k: 1 = the patch centre; k×k points averaged (0: per level)
   std::vector<double> distances;  ///< --distances (default 0.5 0.75 1 2 5 10)
   std::string plots_dir;     ///< --plots DIR
   std::string plot_format = "png";  ///< --plot-format png|svg
   bool json = false;         ///< --json: the report as JSON instead of the table
   bool store_errors = false; ///< --store-errors: write the error tables into the bundle
+  bool independent = false;  ///< --independent: grade the bundle itself even on the rays it was built from
 };
 
 /// The speed-against-error tables of `lumx eval --rays` (also printed by `lumx build`).

@@ -166,8 +166,8 @@ const Command kCommands[] = {
                     "--rays: patch resolution R, 2R^2 equal-area patches per sphere (default 16: 512)")
            ->check(CLI::Range(1, 1024));
        c.add_option("--subsamples", g_eval.subsamples,
-                    "--rays: k x k evaluation points per patch, 1 = the patch centre (default 0: per level, "
-                    "about one per map texel)")
+                    "--rays: 1 = one point per patch, its centre, as a renderer queries (default); k > 1: the mean "
+                    "of k x k points, a patch average that hides texel noise (0: k per level)")
            ->check(CLI::Range(0, 16));
        c.add_option("--distances", g_eval.distances,
                     "--rays: relative distances d, comma-separated (default 0.5,0.75,1,2,5,10)")
@@ -177,6 +177,9 @@ const Command kCommands[] = {
        c.add_option("--plot-format", g_eval.plot_format, "--plots: png (default) or svg")
            ->check(CLI::IsMember({"png", "svg"}));
        c.add_flag("--json", g_eval.json, "--rays: print the report as JSON");
+       c.add_flag("--independent", g_eval.independent,
+                  "--rays: grade the bundle itself even when RAYS are the rays it was built from (by default they "
+                  "are split: levels rebuilt from the even rays, graded on the odd ones)");
        c.add_flag("--store-errors", g_eval.store_errors,
                   "--rays: store each level's relative RMSE table in the bundle (read by the LOD error target)");
        c.callback([&st] { st = lumx_cli::run_eval(g_eval); });
