@@ -149,6 +149,11 @@ bool smooth_at_patch_scale(int i) { return i <= 1; }
 // Printed per level and distance: the error against the exact irradiance at the patch centres / against
 // the exact patch means / the held-out estimate with the noise removed ('<': an upper bound).
 TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
+#if defined(__SANITIZE_ADDRESS__)
+  // Under the sanitizer (about 10× slower) the disk and the box exercise every code path; the other
+  // emitters' agreement is checked by the release build.
+  if (GetParam() != 0 && GetParam() != 4) GTEST_SKIP() << "release build only (sanitizer build: disk and box)";
+#endif
   const std::unique_ptr<AnalyticEmitter> em = suite_emitter(GetParam() % 5);
   auto rays = em->source(kSuiteRays, 11 + std::uint64_t(GetParam()));
   AplBuildOptions bo;
@@ -175,16 +180,24 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
       const std::string where = em->name() + ", " + std::to_string(row->apls) + " APLs, d = " +
                                 std::to_string(r.reference.sphere[s].relative_distance);
       // The reference measures patch means, so the estimate is of the point error against the exact
-      // patch mean: within ±25 % of it where resolved, else an upper bound of it.
+      // patch mean: within ±25 % of it where resolved, else an upper bound of it. To the 25 % is added
+      // three standard errors of the estimate itself (u on ε̂², so 3u/(ε̂ + ε) on ε̂): with 1 M rays it
+      // is a few tenths of a percent, with the sanitizer build's 200 k rays up to 1.5 points.
+      const double slack = [&](double truth_value) {
+        return 0.25 * truth_value + 3 * e.noise_removed_standard_error /
+                                        std::max(1e-12, e.relative_rmse_noise_removed + truth_value);
+      }(truth_mean[s]);
       if (e.resolved) {
-        EXPECT_NEAR(e.relative_rmse_noise_removed, truth_mean[s], 0.25 * truth_mean[s]) << where;
+        EXPECT_NEAR(e.relative_rmse_noise_removed, truth_mean[s], slack) << where;
       } else {
         EXPECT_LE(truth_mean[s], e.noise_removed_upper) << where;
       }
       // Where the irradiance is smooth across a patch (the Lambertian emitters) the patch mean is the
       // centre's value to second order, and the estimate is that of the point error itself.
       if (!fit && smooth_at_patch_scale(GetParam() % 5) && e.resolved) {
-        EXPECT_NEAR(e.relative_rmse_noise_removed, truth[s], 0.25 * truth[s]) << where;
+        EXPECT_NEAR(e.relative_rmse_noise_removed, truth[s],
+                    0.25 * truth[s] + 3 * e.noise_removed_standard_error /
+                                          std::max(1e-12, e.relative_rmse_noise_removed + truth[s])) << where;
       }
     }
     std::printf("\n");

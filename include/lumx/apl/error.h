@@ -101,6 +101,8 @@ struct IrradianceErrors {
   double relative_rmse_noise_removed = NAN;
   /// √(max(0, ε² − σ²) + 2u): what ε̂ is known to be below (its value plus two standard errors of ε̂²).
   double noise_removed_upper = NAN;
+  /// u: the standard error of ε̂² (of ε² − σ², from the reference's noise; header comment).
+  double noise_removed_standard_error = NAN;
   bool resolved = false;       ///< ε̂² > 2u: the error stands out of the reference's noise
   double l2 = NAN;             ///< l² distance of the normalised distributions (001 §6)
   double hellinger = NAN;      ///< Hellinger distance of the normalised distributions (001 §6)
@@ -161,6 +163,7 @@ inline IrradianceErrors compare_irradiance(const std::vector<double>& reference,
   const double u = std::sqrt(u2) / double(n) / m2;
   e.relative_rmse_noise_removed = std::sqrt(std::max(0.0, excess));
   e.noise_removed_upper = std::sqrt(std::max(0.0, excess) + 2 * u);
+  e.noise_removed_standard_error = u;
   e.resolved = excess > 2 * u;
   return e;
 }
