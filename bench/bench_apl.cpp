@@ -18,6 +18,7 @@
 // Bytes per level (memory and disk) are printed by the `bundle_bytes` benchmark as counters.
 #include <lumx/apl/evaluation.h>
 #include <lumx/apl/apl_set.h>
+#include <lumx/apl/error.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/volume/radiance_volume.h>
 #include <lumx/math/spherical_harmonics.h>
@@ -198,6 +199,45 @@ void irradiance_at(benchmark::State& state, bool coherent) {
 void irradiance_random(benchmark::State& state) { irradiance_at(state, false); }
 void irradiance_coherent(benchmark::State& state) { irradiance_at(state, true); }
 BENCHMARK(irradiance_random)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
+
+/// One level of 512 one-channel APLs (as the builder makes them) at map resolution R = range(0): the
+/// cost of a shading point against the size of the maps the held-out fit chooses (R 16–32 for 1 M rays
+/// of smooth emitters) and the rule's R 128. The maps are the box-downsampled copies of one R 128 set.
+void irradiance_512_apls_by_resolution(benchmark::State& state) {
+  static const AplSet fine = [] {
+    AplSet s;
+    s.bounds.radius = 0.3;
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<float> u(-0.3f, 0.3f);
+    AplLevel level;
+    level.map_resolution = 128;
+    for (int i = 0; i < 512; ++i) {
+      Apl a;
+      a.position = {u(rng), u(rng), u(rng)};
+      SphereMap rgb = lobe_map(rng, 128);
+      a.map = SphereMap(128, 1);
+      for (std::size_t t = 0; t < a.map.values().size(); ++t) a.map.values()[t] = rgb.values()[3 * t];
+      level.apls.push_back(std::move(a));
+    }
+    s.levels.push_back(std::move(level));
+    update_fluxes(s);
+    return s;
+  }();
+  AplSet set = fine;
+  set.levels[0] = downsampled_level(fine.levels[0], int(state.range(0)));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::vec3> points(4096);
+  for (glm::vec3& p : points) p = glm::vec3(u(rng), u(rng), -1.0f + 0.5f * u(rng));
+  const glm::vec3 n(0, 0, 1);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(irradiance(set, 0, points[i], n).irradiance);
+    i = (i + 1) & 4095;
+  }
+  state.counters["map_bytes"] = double(set.levels[0].map_bytes());
+}
+BENCHMARK(irradiance_512_apls_by_resolution)->Arg(16)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMicrosecond);
 BENCHMARK(irradiance_coherent)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
 
 void sample(benchmark::State& state) {

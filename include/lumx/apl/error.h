@@ -585,16 +585,27 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
 // query sees it; coarser texels trade that noise for blur. Which wins depends on the luminaire, the level
 // and the ray count, so it is measured: each level's maps are box-downsampled (flux-exact on equal-area
 // maps) by halving from the built resolution, every candidate is graded at the points of the
-// measurement spheres against held-out rays, and the one with the least Σ_d ε(d)² is kept. (The noise
-// variance of the reference is the same for every candidate, so the raw ε ranks them as ε̂ does.) The
+// measurement spheres against held-out rays, and the one with the least Σ_d log ε(d) (the geometric mean
+// over the distances, so that each distance counts by its relative change: a one-APL level is hopeless
+// near a spot whatever its maps, and a plain sum would let that decide its far field) is kept. (The
+// noise variance of the reference is the same for every candidate, so the raw ε ranks them.) The
 // choice is made on a set built from half the rays; a set from all of them has half the noise variance
 // and might afford one step finer — the choice is the conservative one.
 
-/// Per level, the chosen resolution and the Σ_d ε(d)² of each candidate tried (finest first).
+/// Per level, the chosen resolution and the Σ_d log ε(d) of each candidate tried (finest first).
 struct ResolutionChoice {
   std::vector<int> resolution;                        ///< per level
-  std::vector<std::vector<std::pair<int, double>>> tried;  ///< per level: (R, Σ_d ε²)
+  std::vector<std::vector<std::pair<int, double>>> tried;  ///< per level: (R, Σ_d log ε)
 };
+
+/// The patch resolution fit_map_resolutions grades on in evaluate_held_out_fitted, for `rays` fitting rays
+/// (0: unknown) and the report's patch resolution (see there).
+inline int fit_patch_resolution(int patch_resolution, std::uint64_t rays) {
+  const int low = std::min(1024, 2 * patch_resolution), high = std::max(low, 64);
+  int R = low;
+  while (R * 2 <= high && 2.0 * (2.0 * R) * (2.0 * R) * 32.0 <= double(rays)) R *= 2;
+  return R;
+}
 
 /// The level's maps box-downsampled to resolution R (a power-of-two fraction of theirs; else throws).
 inline AplLevel downsampled_level(const AplLevel& level, int R) {
@@ -627,7 +638,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       const LevelErrors row = evaluate_level(set, k, ref, o);
       double cost = 0;
       for (const IrradianceErrors& e : row.errors)
-        if (std::isfinite(e.relative_rmse)) cost += e.relative_rmse * e.relative_rmse;
+        if (std::isfinite(e.relative_rmse) && e.relative_rmse > 0) cost += std::log(e.relative_rmse);
       tried.push_back({R, cost});
       if (cost < best_cost) best_cost = cost, best = R;
       if (R % 2 != 0) break;
@@ -659,10 +670,12 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
     RayHalf fit(odd, 0);
     AplErrorOptions quiet = options;
     quiet.progress = nullptr;
-    // Patches of half the size for the choice: a patch mean hides detail finer than the patch, so the
-    // grading resolution would otherwise cap the resolution chosen (a cos^20 spot: R 16 → 32 and its
-    // point error at d = 1 from 19 % to 7 % with 1 M rays).
-    quiet.patch_resolution = std::min(1024, 2 * options.patch_resolution);
+    // Finer patches for the choice: a patch mean hides detail finer than the patch, so the grading
+    // resolution would otherwise cap the resolution chosen (a cos^20 spot: R 16 → 32 and its point error
+    // at d = 1 from 19 % to 7 % with 1 M rays). At least twice the grading resolution, finer while the
+    // fitting rays give ≥ 32 per patch on average, at most 64 (8192 patches: the cost of grading every
+    // candidate). Candidates are ranked on one reference, so its noise mostly cancels in the ranking.
+    quiet.patch_resolution = fit_patch_resolution(options.patch_resolution, fit.info().ray_count);
     const ReferenceIrradiance fit_ref = gather_reference(fit, set.bounds, quiet);
     c = fit_map_resolutions(set, fit_ref, quiet, min_resolution);
   }
@@ -703,6 +716,29 @@ inline void store_error_tables(AplSet& set, const AplErrorReport& report) {
                                   " of the report does not match the set's");
   for (std::size_t k = 0; k < set.levels.size(); ++k)
     set.levels[k].error = error_table(report.levels[k], report.reference);
+}
+
+/// What `lumx build` ships: `build(rays)` on every ray, each level's maps downsampled to the resolution
+/// fitted on held-out rays (evaluate_held_out_fitted), and the held-out error tables stored in it. When
+/// half the rays give other levels than all of them (tiny raysets) the set is returned as built, without
+/// tables. `report`, when given, receives the held-out report; `fitted` whether the choice was applied.
+template <class Build>
+AplSet build_with_held_out_errors(RaySource& rays, Build&& build, const AplErrorOptions& options = {},
+                                  AplErrorReport* report = nullptr, bool* fitted = nullptr) {
+  ResolutionChoice choice;
+  AplErrorReport r = evaluate_held_out_fitted(rays, build, options, &choice);
+  AplSet set = build(rays);
+  bool same = r.levels.size() == set.levels.size();
+  for (std::size_t k = 0; same && k < set.levels.size(); ++k) same = r.levels[k].apls == set.levels[k].size();
+  if (same) {
+    for (std::size_t k = 0; k < set.levels.size(); ++k)
+      if (choice.resolution[k] <= set.levels[k].map_resolution)
+        set.levels[k] = downsampled_level(set.levels[k], choice.resolution[k]);
+    store_error_tables(set, r);
+  }
+  if (fitted) *fitted = same;
+  if (report) *report = std::move(r);
+  return set;
 }
 
 LUMX_NAMESPACE_END
