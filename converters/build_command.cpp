@@ -156,21 +156,23 @@ int run_build(const BuildArgs& a) {
       lumx::AplBuildOptions half = bo;
       half.progress = [&](double f, const char*) { bar.update(0.5 * f, "held-out build"); };
       eo.progress = [&](double f, const char* phase) { bar.update(0.5 + 0.5 * f, phase); };
+      // With --map-resolution the resolution is the caller's; else it is fitted on held-out rays.
       lumx::ResolutionChoice choice;
-      report = lumx::evaluate_held_out_fitted(
-          *rays, [&](lumx::RaySource& train) { return lumx::build_apl_set(train, half); }, eo, &choice);
-      bool same = report.levels.size() == set.levels.size();
-      for (std::size_t k = 0; same && k < set.levels.size(); ++k) same = report.levels[k].apls == set.levels[k].size();
-      if (same && a.map_resolution == 0) {
-        // The map resolutions chosen on held-out rays, applied to the levels built from every ray.
-        for (std::size_t k = 0; k < set.levels.size(); ++k)
-          set.levels[k] = lumx::downsampled_level(set.levels[k], choice.resolution[k]);
-      }
-      if (same) {
-        lumx::store_error_tables(set, report);
-        set.provenance["error_tables"] = "held out: levels built from the even rays, map resolutions chosen on "
-                                         "rays 1, 5, 9, ..., irradiance at patch centres against rays 3, 7, 11, "
-                                         "..., their noise removed";
+      const auto build_half = [&](lumx::RaySource& train) { return lumx::build_apl_set(train, half); };
+      report = a.map_resolution > 0 ? lumx::evaluate_held_out(*rays, build_half, eo)
+                                    : lumx::evaluate_held_out_fitted(*rays, build_half, eo, &choice);
+      if (lumx::apply_held_out_fit(set, report, a.map_resolution > 0 ? nullptr : &choice)) {
+        if (a.map_resolution == 0) {
+          std::printf("maps:     resolutions chosen on held-out rays:");
+          for (std::size_t k = 0; k < set.levels.size(); ++k) std::printf(" %d", set.levels[k].map_resolution);
+          std::printf(" (levels 0..%zu)\n", set.levels.size() - 1);
+        }
+        set.provenance["error_tables"] = a.map_resolution > 0
+                                             ? "held out: levels built from the even rays, irradiance at patch "
+                                               "centres against the odd rays, their noise removed"
+                                             : "held out: levels built from the even rays, map resolutions chosen "
+                                               "on rays 1, 5, 9, ..., irradiance at patch centres against rays 3, "
+                                               "7, 11, ..., their noise removed";
       } else {
         std::fprintf(stderr, "%s: note: the half rayset gives other levels than the whole; no error table is "
                              "stored\n", a.rays.c_str());

@@ -493,7 +493,10 @@ int run_rays(const EvalArgs& a) {
     bo.threads = std::max(1u, std::thread::hardware_concurrency());
     std::fprintf(stderr, "%s: note: these rays built the bundle; its levels are rebuilt from the even rays and graded "
                          "on the odd ones\n", a.rays.c_str());
-    report = lumx::evaluate_held_out(*rays, [&](lumx::RaySource& train) { return lumx::build_apl_set(train, bo); }, o);
+    // As lumx build graded it: resolutions fitted on held-out rays unless the build fixed them.
+    const auto build_half = [&](lumx::RaySource& train) { return lumx::build_apl_set(train, bo); };
+    report = bo.map_resolution > 0 ? lumx::evaluate_held_out(*rays, build_half, o)
+                                   : lumx::evaluate_held_out_fitted(*rays, build_half, o);
     graded += " (its levels rebuilt from the even rays)";
     against += " (the odd rays)";
   } else {

@@ -718,25 +718,34 @@ inline void store_error_tables(AplSet& set, const AplErrorReport& report) {
     set.levels[k].error = error_table(report.levels[k], report.reference);
 }
 
+/// Applies a held-out fit to a set built from every ray: each level's maps downsampled to the chosen
+/// resolution (when `choice` is given and not finer than the level's) and the report's error tables
+/// stored. False, and the set untouched, when the report's levels are not the set's (half the rays of a
+/// tiny rayset can give other levels).
+inline bool apply_held_out_fit(AplSet& set, const AplErrorReport& report, const ResolutionChoice* choice = nullptr) {
+  bool same = report.levels.size() == set.levels.size();
+  for (std::size_t k = 0; same && k < set.levels.size(); ++k) same = report.levels[k].apls == set.levels[k].size();
+  if (!same) return false;
+  if (choice)
+    for (std::size_t k = 0; k < set.levels.size() && k < choice->resolution.size(); ++k)
+      if (choice->resolution[k] <= set.levels[k].map_resolution)
+        set.levels[k] = downsampled_level(set.levels[k], choice->resolution[k]);
+  store_error_tables(set, report);
+  return true;
+}
+
 /// What `lumx build` ships: `build(rays)` on every ray, each level's maps downsampled to the resolution
-/// fitted on held-out rays (evaluate_held_out_fitted), and the held-out error tables stored in it. When
-/// half the rays give other levels than all of them (tiny raysets) the set is returned as built, without
-/// tables. `report`, when given, receives the held-out report; `fitted` whether the choice was applied.
+/// fitted on held-out rays (evaluate_held_out_fitted), and the held-out error tables stored in it
+/// (apply_held_out_fit; without tables when half the rays give other levels). `report`, when given,
+/// receives the held-out report; `fitted` whether the fit was applied.
 template <class Build>
 AplSet build_with_held_out_errors(RaySource& rays, Build&& build, const AplErrorOptions& options = {},
                                   AplErrorReport* report = nullptr, bool* fitted = nullptr) {
   ResolutionChoice choice;
   AplErrorReport r = evaluate_held_out_fitted(rays, build, options, &choice);
   AplSet set = build(rays);
-  bool same = r.levels.size() == set.levels.size();
-  for (std::size_t k = 0; same && k < set.levels.size(); ++k) same = r.levels[k].apls == set.levels[k].size();
-  if (same) {
-    for (std::size_t k = 0; k < set.levels.size(); ++k)
-      if (choice.resolution[k] <= set.levels[k].map_resolution)
-        set.levels[k] = downsampled_level(set.levels[k], choice.resolution[k]);
-    store_error_tables(set, r);
-  }
-  if (fitted) *fitted = same;
+  const bool applied = apply_held_out_fit(set, r, &choice);
+  if (fitted) *fitted = applied;
   if (report) *report = std::move(r);
   return set;
 }
