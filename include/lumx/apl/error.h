@@ -596,6 +596,10 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
 struct ResolutionChoice {
   std::vector<int> resolution;                        ///< per level
   std::vector<std::vector<std::pair<int, double>>> tried;  ///< per level: (R, Σ_d log ε)
+  /// The resolution of level 0's maps for the far field alone (IES/EULUMDAT export), fitted at d = 5 and
+  /// 10 on patches of R 64 (3° wide): a far field needs angular detail the near field's compromise can
+  /// give away (evaluate_held_out_fitted). 0 when not fitted.
+  int far_field_resolution = 0;
 };
 
 /// The patch resolution fit_map_resolutions grades on in evaluate_held_out_fitted, for `rays` fitting rays
@@ -676,8 +680,15 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
     // fitting rays give ≥ 32 per patch on average, at most 64 (8192 patches: the cost of grading every
     // candidate). Candidates are ranked on one reference, so its noise mostly cancels in the ranking.
     quiet.patch_resolution = fit_patch_resolution(options.patch_resolution, fit.info().ray_count);
+    AplSet far = set;
+    far.levels.resize(1);
     const ReferenceIrradiance fit_ref = gather_reference(fit, set.bounds, quiet);
     c = fit_map_resolutions(set, fit_ref, quiet, min_resolution);
+    AplErrorOptions far_options = quiet;
+    far_options.relative_distances = {5, 10};
+    far_options.patch_resolution = 64;
+    const ReferenceIrradiance far_ref = gather_reference(fit, set.bounds, far_options);
+    c.far_field_resolution = fit_map_resolutions(far, far_ref, far_options, min_resolution).resolution.at(0);
   }
   RayHalf test(odd, 1);
   AplErrorReport report = evaluate_apl_errors(set, test, options);

@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// `lumx build` and `lumx eval --rays` as a user runs them on a rayset of an analytic emitter: held-out
+// error tables stored and printed, map resolutions chosen on held-out rays, the same numbers as the
+// library's (whatever the thread count), the bundle's own rays regraded by rebuilding from half.
+#include <lumx/apl/builder.h>
+#include <lumx/apl/error.h>
+#include <lumx/io/bundle_io.h>
+#include <lumx/io/photometry_io.h>
+#include <lumx/io/rayset_io.h>
+#include <lumx/photometry/intensity_table.h>
+
+#include <gtest/gtest.h>
+
+#include "analytic_emitters.h"
+#include "cli_test_support.h"
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using namespace lumx;
+
+namespace {
+
+bool has(const std::string& text, const std::string& what) { return text.find(what) != std::string::npos; }
+
+struct BuiltDisk {
+  fs::path dir, rays, bundle;
+  lumx_test::CliRun build;
+  BuiltDisk() : dir(fs::temp_directory_path() / ("lumx_cli_build_" + std::to_string(::getpid()))) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    rays = dir / "disk.tm25ray";
+    bundle = dir / "disk.lumx";
+    const lumx_test::PlanarEmitter disk("disk", lumx_test::PlanarEmitter::Shape::disk, 0.1, 0, 1, 1000);
+    auto src = disk.source(200000, 21);
+    RaysetInfo info = src->info();
+    info.header_flux = 1000;
+    write_tm25(rays.string(), info, *src);
+    build = lumx_test::run_cli("build " + lumx_test::quoted(rays) + " " + lumx_test::quoted(bundle) +
+                               " --levels 1 8 64");
+  }
+  ~BuiltDisk() { fs::remove_all(dir); }
+};
+
+}  // namespace
+
+TEST(CliBuild, StoresAndPrintsHeldOutTablesTheLibraryReproduces) {
+  const BuiltDisk b;
+  ASSERT_EQ(b.build.status, 0) << b.build.out;
+  EXPECT_TRUE(has(b.build.out, "rays not used to build the levels, their noise removed")) << b.build.out;
+  EXPECT_TRUE(has(b.build.out, "maps:     resolutions chosen on held-out rays:")) << b.build.out;
+  EXPECT_TRUE(has(b.build.out, "(the odd rays)")) << b.build.out;
+  EXPECT_TRUE(has(b.build.out, "noise floor")) << b.build.out;
+  EXPECT_EQ(lumx_test::run_cli("check " + lumx_test::quoted(b.bundle)).status, 0);
+
+  const BundleReader reader(b.bundle.string());
+  const auto& prov = reader.manifest().provenance;
+  EXPECT_EQ(prov.at("error_tables").rfind("held out", 0), 0u) << prov.at("error_tables");
+  EXPECT_EQ(prov.at("source_rays"), "200000");
+  ASSERT_EQ(reader.manifest().levels.size(), 3u);
+
+  // The library on the same file, one thread (the CLI used every core): the same tables and resolutions.
+  const auto rays = open_rayset(b.rays.string());
+  AplBuildOptions bo;
+  bo.level_counts = {1, 8, 64};
+  bo.threads = 1;
+  AplErrorReport report;
+  bool fitted = false;
+  const AplSet set = build_with_held_out_errors(
+      *rays, [&](RaySource& r) { return build_apl_set(r, bo); }, AplErrorOptions{}, &report, &fitted);
+  ASSERT_TRUE(fitted);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const ErrorTable& stored = reader.manifest().levels[k].error;
+    ASSERT_EQ(stored.relative_distance, (std::vector<double>{0.5, 0.75, 1, 2, 5, 10})) << k;
+    for (std::size_t s = 0; s < 6; ++s) {
+      EXPECT_EQ(stored.relative_rmse[s], set.levels[k].error.relative_rmse[s]) << k << " " << s;
+      EXPECT_GT(stored.relative_rmse[s], 0) << k << " " << s;
+    }
+    EXPECT_EQ(reader.manifest().levels[k].map_resolution, set.levels[k].map_resolution) << k;
+    EXPECT_EQ(set.levels[k].map_resolution, report.levels[k].map_resolution) << k;
+  }
+
+  // The attached far field carries the rays' flux (0.5 %: the Type C grid's quadrature of the map).
+  bool found = false;
+  for (std::size_t i = 0; i < reader.manifest().attachments.size(); ++i)
+    if (reader.manifest().attachments[i].first.name == "far_field.ies") {
+      found = true;
+      const std::string bytes = reader.read_attachment(i);
+      const Photometry p = read_ies(std::string_view(bytes), "far_field.ies");
+      EXPECT_NEAR(IntensityTable(p).flux_lm(), 1000, 5);
+    }
+  EXPECT_TRUE(found);
+}
+
+TEST(CliBuild, EvalOnTheBundlesOwnRaysRebuildsFromHalf) {
+  const BuiltDisk b;
+  ASSERT_EQ(b.build.status, 0) << b.build.out;
+  const lumx_test::CliRun own = lumx_test::run_cli("eval " + lumx_test::quoted(b.bundle) + " --rays " + lumx_test::quoted(b.rays));
+  ASSERT_EQ(own.status, 0) << own.out;
+  EXPECT_TRUE(has(own.out, "these rays built the bundle")) << own.out;
+  EXPECT_TRUE(has(own.out, "(its levels rebuilt from the even rays)")) << own.out;
+  const lumx_test::CliRun forced =
+      lumx_test::run_cli("eval " + lumx_test::quoted(b.bundle) + " --rays " + lumx_test::quoted(b.rays) + " --independent");
+  ASSERT_EQ(forced.status, 0) << forced.out;
+  EXPECT_TRUE(has(forced.out, "(the rays it was built from: errors shared with them cancel)")) << forced.out;
+  EXPECT_FALSE(has(forced.out, "rebuilt from the even rays")) << forced.out;
+}
