@@ -195,9 +195,15 @@ int run_build(const BuildArgs& a) {
       // tabulated on the Type C grid: the ray histogram on that grid would give each of its ~26 000
       // cells a few hundred rays of a million (a Lambertian disk's IES from 1 M rays: 15 % off at d = 10
       // binned, 3.5 % from the fitted map).
-      lumx::AplSet far_set = set;
-      if (choice.far_field_resolution > 0 && choice.far_field_resolution <= built_level0.map_resolution)
-        far_set.levels.at(0) = lumx::downsampled_level(built_level0, choice.far_field_resolution);
+      // Only level 0 is needed: a set of that one level, not a copy of every level's maps.
+      lumx::AplSet far_set;
+      far_set.quantity = set.quantity;
+      far_set.channels = set.channels;
+      far_set.provenance = set.provenance;
+      far_set.levels.push_back(choice.far_field_resolution > 0 &&
+                                       choice.far_field_resolution <= built_level0.map_resolution
+                                   ? lumx::downsampled_level(built_level0, choice.far_field_resolution)
+                                   : set.levels.at(0));
       const lumx::Photometry far = lumx::far_field_photometry(far_set, 0, grid);
       wo.attachments.push_back({"far_field.ies", "application/x-ies-lm63", lumx::format_ies(far)});
       wo.attachments.push_back({"far_field.ldt", "application/x-eulumdat", lumx::format_ldt(far)});

@@ -564,20 +564,17 @@ inline AplErrorReport evaluate_apl_errors(const AplSet& set, RaySource& rays, co
 
 /// Honest errors of the sets a builder makes from a rayset: `build(RaySource&) -> AplSet` is called on the
 /// even rays of `rays` (flux ×2, rays/holdout.h) and its set graded against the odd rays (flux ×2), which
-/// it never saw. `trained`, when given, receives the graded set. The set built from all the rays has
+/// it never saw. The set built from all the rays has
 /// half this set's noise variance, so these errors bound its own from above.
 template <class Build>
-AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorOptions& options = {},
-                                 AplSet* trained = nullptr) {
+AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorOptions& options = {}) {
   AplSet set;
   {
     RayHalf train(rays, 0);
     set = build(static_cast<RaySource&>(train));
   }
   RayHalf test(rays, 1);
-  AplErrorReport report = evaluate_apl_errors(set, test, options);
-  if (trained) *trained = std::move(set);
-  return report;
+  return evaluate_apl_errors(set, test, options);
 }
 
 // ---- Map resolution by held-out error
@@ -660,8 +657,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
 /// the resolutions, to apply to a set built from all the rays (downsampled_level).
 template <class Build>
 AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const AplErrorOptions& options = {},
-                                        ResolutionChoice* choice = nullptr, AplSet* trained = nullptr,
-                                        int min_resolution = 4) {
+                                        ResolutionChoice* choice = nullptr, int min_resolution = 4) {
   AplSet set;
   {
     RayHalf train(rays, 0);
@@ -693,7 +689,6 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
   RayHalf test(odd, 1);
   AplErrorReport report = evaluate_apl_errors(set, test, options);
   if (choice) *choice = std::move(c);
-  if (trained) *trained = std::move(set);
   return report;
 }
 
