@@ -1,3 +1,364 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
+// The particle tracer of lumx/bake/tracer.h: emitter sampling, the Embree scene, the path loop and the ordered,
+// chunked parallel driver.
 #include <lumx/bake/tracer.h>
+
+#include "bake/emitter_sampler.h"
+
+#include <lumx/bake/bsdf.h>
+#include <lumx/bake/random.h>
+
+#include <embree3/rtcore.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+LUMX_NAMESPACE_BEGIN
+namespace bake {
+
+void TraceCounters::add(const TraceCounters& o) {
+  emitted += o.emitted;
+  exited += o.exited;
+  absorbed += o.absorbed;
+  roulette_killed += o.roulette_killed;
+  depth_capped += o.depth_capped;
+  leaked += o.leaked;
+  segments += o.segments;
+  emitted_lm += o.emitted_lm;
+  exited_lm += o.exited_lm;
+}
+
+namespace {
+
+double max_component(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
+/// Orthonormal basis around unit n (Duff et al. 2017, "Building an Orthonormal Basis, Revisited", JCGT 6(1)).
+struct Frame {
+  glm::dvec3 s, t, n;
+  explicit Frame(const glm::dvec3& normal) : n(normal) {
+    const double sign = std::copysign(1.0, n.z);
+    const double a = -1.0 / (sign + n.z);
+    const double b = n.x * n.y * a;
+    s = {1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x};
+    t = {b, sign + n.y * n.y * a, -n.y};
+  }
+  glm::dvec3 to_local(const glm::dvec3& v) const { return {glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)}; }
+  glm::dvec3 to_world(const glm::dvec3& v) const { return v.x * s + v.y * t + v.z * n; }
+};
+
+/// A small stack of the volume parts a particle is inside (nested solids: a bulb inside a glass globe).
+struct MediumStack {
+  static constexpr int kCapacity = 8;
+  std::uint32_t part[kCapacity];
+  int size = 0;
+  void push(std::uint32_t p) {
+    if (size < kCapacity) part[size++] = p;
+  }
+  void remove(std::uint32_t p) {
+    for (int i = size - 1; i >= 0; --i)
+      if (part[i] == p) {
+        for (int j = i; j + 1 < size; ++j) part[j] = part[j + 1];
+        --size;
+        return;
+      }
+  }
+  bool empty() const { return size == 0; }
+  std::uint32_t top() const { return part[size - 1]; }
+};
+
+}  // namespace
+
+struct Tracer::Impl {
+  const LuminaireScene& scene;
+  RTCDevice device = nullptr;
+  RTCScene rtc_scene = nullptr;
+  std::vector<Bsdf> bsdfs;                 // one per material
+  std::vector<Rgb> absorption;             // per material, 1/m
+  std::vector<std::uint8_t> part_volume;   // per part: its material is a closed solid
+  EmitterSampler emitters;
+  double offset_scale = 1e-6;              // self-intersection offset, m (from the scene's extent)
+
+  explicit Impl(const LuminaireScene& s) : scene(s), emitters(s) {
+    for (const Material& m : s.materials) {
+      bsdfs.emplace_back(m);
+      absorption.push_back(m.absorption_per_m());
+    }
+    part_volume.resize(s.parts.size());
+    for (std::size_t p = 0; p < s.parts.size(); ++p) part_volume[p] = s.materials.at(s.parts[p].material).volume;
+
+    glm::dvec3 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
+    for (const glm::vec3& p : s.positions) {
+      lo = glm::min(lo, glm::dvec3(p));
+      hi = glm::max(hi, glm::dvec3(p));
+    }
+    const double extent = s.positions.empty() ? 1.0 : glm::length(hi - lo);
+    // 1e-5 of the luminaire's diagonal (5 µm for a 0.5 m luminaire): far above float rounding of positions
+    // (2⁻²⁴ relative), far below any wall thickness a luminaire is modelled with.
+    offset_scale = 1e-5 * std::max(extent, 1e-3);
+
+    device = rtcNewDevice(nullptr);
+    if (!device) throw std::runtime_error("Embree: rtcNewDevice failed");
+    rtc_scene = rtcNewScene(device);
+    rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
+    if (s.triangle_count() > 0) {
+      RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                             3 * sizeof(float), s.positions.size()));
+      for (std::size_t i = 0; i < s.positions.size(); ++i) {
+        vb[3 * i] = s.positions[i].x;
+        vb[3 * i + 1] = s.positions[i].y;
+        vb[3 * i + 2] = s.positions[i].z;
+      }
+      auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                3 * sizeof(unsigned), s.triangle_count()));
+      std::copy(s.indices.begin(), s.indices.end(), ib);
+      rtcCommitGeometry(geom);
+      rtcAttachGeometry(rtc_scene, geom);
+      rtcReleaseGeometry(geom);
+    }
+    rtcCommitScene(rtc_scene);
+  }
+
+  ~Impl() {
+    if (rtc_scene) rtcReleaseScene(rtc_scene);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  /// Origin moved off the surface at p (geometric normal ng) to the side direction d leaves on.
+  glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d) const {
+    const double magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    const double eps = offset_scale + 64.0 * FLT_EPSILON * magnitude;
+    return p + (glm::dot(d, ng) >= 0.0 ? eps : -eps) * ng;
+  }
+
+  void trace_particle(std::uint64_t index, const TraceOptions& o, double particle_flux, ParticleChunk& out,
+                      TraceCounters& c) const;
+};
+
+Tracer::Tracer(const LuminaireScene& scene) : impl_(std::make_unique<Impl>(scene)) {}
+Tracer::~Tracer() = default;
+
+double Tracer::total_flux_lm() const { return impl_->emitters.total_flux_lm(); }
+Rgb Tracer::total_flux_rgb() const { return impl_->emitters.total_flux_rgb(); }
+const LuminaireScene& Tracer::scene() const { return impl_->scene; }
+
+void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, double particle_flux,
+                                  ParticleChunk& out, TraceCounters& c) const {
+  Pcg32 rng(mix64(o.seed) ^ mix64(index + 0x5bd1e995ULL), index);
+  const EmittedParticle e = emitters.sample(rng);
+  c.emitted += 1;
+  Rgb beta = particle_flux * e.flux_weight;  // per channel; luminance(e.flux_weight) = weight
+  c.emitted_lm += luminance(beta);
+  const double beta0_max = std::max(max_component(beta), 1e-300);
+  if (!(max_component(beta) > 0.0)) {
+    c.absorbed += 1;
+    return;
+  }
+
+  glm::dvec3 position = e.position;
+  glm::dvec3 direction = e.direction;
+  glm::dvec3 origin = e.has_surface ? offset_origin(e.position, e.surface_normal, e.direction) : e.position;
+  MediumStack media;
+  std::uint32_t bounces = 0;
+
+  for (;;) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    RTCRayHit rh;
+    rh.ray.org_x = float(origin.x), rh.ray.org_y = float(origin.y), rh.ray.org_z = float(origin.z);
+    rh.ray.dir_x = float(direction.x), rh.ray.dir_y = float(direction.y), rh.ray.dir_z = float(direction.z);
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.time = 0.0f;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_scene, &context, &rh);
+    c.segments += 1;
+
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      ExitParticle x;
+      x.position = glm::vec3(position);
+      x.direction = glm::vec3(direction);
+      x.flux_lm = glm::vec3(beta);
+      x.index = index;
+      x.emitter = e.emitter;
+      x.bounces = bounces;
+      out.exits.push_back(x);
+      c.exited += 1;
+      c.exited_lm += luminance(beta);
+      return;
+    }
+
+    const double t = double(rh.ray.tfar);
+    if (o.record_segments) {
+      PathSegment seg;
+      seg.origin = glm::vec3(origin);
+      seg.direction = glm::vec3(direction);
+      seg.length_m = float(t);
+      seg.flux_lm = glm::vec3(beta);
+      out.segments.push_back(seg);
+    }
+    if (!media.empty()) {  // Beer–Lambert transmittance exp(−σ t) inside the current solid
+      const Rgb& sigma = absorption[scene.parts[media.top()].material];
+      for (int ch = 0; ch < 3; ++ch) beta[ch] *= sigma[ch] > 0.0 ? std::exp(-sigma[ch] * t) : 1.0;
+    }
+
+    const std::uint32_t tri = rh.hit.primID;
+    const std::uint32_t part_index = scene.triangle_part[tri];
+    const std::uint32_t material_index = scene.parts[part_index].material;
+    const Material& material = scene.materials[material_index];
+    const glm::dvec3 a = scene.positions[scene.indices[3 * tri]];
+    const glm::dvec3 b = scene.positions[scene.indices[3 * tri + 1]];
+    const glm::dvec3 cc = scene.positions[scene.indices[3 * tri + 2]];
+    glm::dvec3 ng = glm::cross(b - a, cc - a);
+    const double ng_len = glm::length(ng);
+    position = origin + t * direction;
+    if (!(ng_len > 0.0) || !std::isfinite(ng_len)) {  // degenerate triangle: pass straight through
+      origin = position + offset_scale * direction;
+      continue;
+    }
+    ng /= ng_len;
+    glm::dvec3 ns = ng;
+    if (!scene.normals.empty()) {
+      const double u = rh.hit.u, v = rh.hit.v;
+      const glm::dvec3 interpolated = (1.0 - u - v) * glm::dvec3(scene.normals[scene.indices[3 * tri]]) +
+                                      u * glm::dvec3(scene.normals[scene.indices[3 * tri + 1]]) +
+                                      v * glm::dvec3(scene.normals[scene.indices[3 * tri + 2]]);
+      const double len = glm::length(interpolated);
+      if (len > 0.0 && std::isfinite(len)) ns = interpolated / len;
+      if (glm::dot(ns, ng) < 0.0) ns = -ns;  // normals against the winding: trust the winding's side
+    }
+
+    const glm::dvec3 wo = -direction;
+    const bool front = glm::dot(wo, ng) > 0.0;
+    const bool thin_two_sided =
+        !material.volume && (material.double_sided || material.transmission > 0.0 || material.diffuse_transmission > 0.0);
+    if (!front && !material.volume) {
+      if (!thin_two_sided) {  // the back of a one-sided opaque surface is black
+        c.absorbed += 1;
+        return;
+      }
+      ng = -ng;
+      ns = -ns;
+    }
+
+    if (bounces >= std::uint32_t(o.max_depth)) {
+      c.depth_capped += 1;
+      return;
+    }
+    ++bounces;
+
+    const Frame frame(ns);
+    const glm::dvec3 wo_local = frame.to_local(wo);
+    // Light leaks: wo must lie on the same side of the geometric and the shading surface (Veach 1997 §5.3).
+    if ((glm::dot(wo, ng) > 0.0) != (wo_local.z > 0.0)) {
+      c.leaked += 1;
+      return;
+    }
+    const double u_lobe = rng.next_double();
+    const glm::dvec2 u{rng.next_double(), rng.next_double()};
+    const std::optional<BsdfSample> s = bsdfs[material_index].sample(wo_local, u_lobe, u, TransportMode::importance);
+    if (!s || !(max_component(s->weight) > 0.0)) {
+      c.absorbed += 1;
+      return;
+    }
+    const glm::dvec3 wi = glm::normalize(frame.to_world(s->wi));
+    const double wi_ng = glm::dot(wi, ng);
+    if ((wi_ng > 0.0) != (s->wi.z > 0.0) || wi_ng == 0.0) {
+      c.leaked += 1;
+      return;
+    }
+    // Adjoint shading-normal correction (Veach 1997 eq. 5.17): |wo·ns| |wi·ng| / (|wo·ng| |wi·ns|).
+    const double correction = std::abs(wo_local.z) * std::abs(wi_ng) /
+                              std::max(std::abs(glm::dot(wo, ng)) * std::abs(s->wi.z), 1e-300);
+    beta *= s->weight * correction;
+    if (!(max_component(beta) < std::numeric_limits<double>::infinity())) {
+      c.absorbed += 1;  // a non-finite weight is a BSDF defect; end the path rather than poison the sums
+      return;
+    }
+
+    if (material.volume && s->transmitted) {
+      if (front)
+        media.push(part_index);
+      else
+        media.remove(part_index);
+    }
+
+    if (int(bounces) >= o.roulette_depth) {
+      // Survival ∝ throughput relative to the emitted flux (capped at 1): particles that lost most of their
+      // flux end early, survivors are re-weighted by 1/q so the estimate stays unbiased.
+      const double q = std::min(1.0, max_component(beta) / beta0_max);
+      if (rng.next_double() >= q) {
+        c.roulette_killed += 1;
+        return;
+      }
+      beta /= q;
+    }
+
+    origin = offset_origin(position, ng, wi);
+    direction = wi;
+  }
+}
+
+TraceCounters Tracer::trace(const TraceOptions& o, ParticleSink& sink) const {
+  TraceCounters total;
+  if (o.particles == 0) return total;
+  const std::uint64_t normalization = o.normalization_particles ? o.normalization_particles : o.particles;
+  const double particle_flux = impl_->emitters.total_flux_lm() / double(normalization);
+  const std::uint64_t chunk = std::max<std::uint32_t>(1, o.chunk_particles);
+  const std::uint64_t chunks = (o.particles + chunk - 1) / chunk;
+  const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+
+  struct Work {
+    ParticleChunk chunk;
+    TraceCounters counters;
+  };
+  std::uint64_t next_chunk = 0;
+  tbb::task_arena arena(threads);
+  arena.execute([&] {
+    tbb::parallel_pipeline(
+        std::size_t(2 * threads),
+        tbb::make_filter<void, std::uint64_t>(tbb::filter_mode::serial_in_order,
+                                              [&](tbb::flow_control& fc) -> std::uint64_t {
+                                                if (next_chunk >= chunks) {
+                                                  fc.stop();
+                                                  return 0;
+                                                }
+                                                return next_chunk++;
+                                              }) &
+            tbb::make_filter<std::uint64_t, std::shared_ptr<Work>>(
+                tbb::filter_mode::parallel,
+                [&](std::uint64_t k) {
+                  auto w = std::make_shared<Work>();
+                  const std::uint64_t begin = o.first_particle + k * chunk;
+                  const std::uint64_t end = o.first_particle + std::min(o.particles, (k + 1) * chunk);
+                  w->chunk.first_particle = begin;
+                  w->chunk.particle_count = end - begin;
+                  w->chunk.exits.reserve(end - begin);
+                  for (std::uint64_t i = begin; i < end; ++i)
+                    impl_->trace_particle(i, o, particle_flux, w->chunk, w->counters);
+                  return w;
+                }) &
+            tbb::make_filter<std::shared_ptr<Work>, void>(tbb::filter_mode::serial_in_order,
+                                                          [&](const std::shared_ptr<Work>& w) {
+                                                            sink.consume(w->chunk);
+                                                            total.add(w->counters);
+                                                          }));
+  });
+  return total;
+}
+
+}  // namespace bake
+LUMX_NAMESPACE_END

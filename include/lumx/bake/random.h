@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// lumx/bake/random.h — per-particle random streams: PCG32 (O'Neill 2014, "PCG: A Family of Simple Fast
+// Space-Efficient Statistically Good Algorithms for Random Number Generation", §6.3 XSH-RR output on a
+// 64-bit LCG). Particle i of a trace with seed s draws from the LCG stream selected by i (the increment)
+// started at a state derived from s, so its numbers depend on (s, i) only: not on the thread, the chunk
+// or the order in which particles are traced.
+#pragma once
+
+#include <lumx/version.h>
+
+#include <cstdint>
+
+LUMX_NAMESPACE_BEGIN
+namespace bake {
+
+/// SplitMix64 finaliser (Steele, Lea & Flood 2014): a bijective 64-bit mix, here to decorrelate seeds.
+inline std::uint64_t mix64(std::uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+class Pcg32 {
+ public:
+  /// Stream `stream` (any 64-bit value; the LCG increment is 2·stream + 1) started from `seed`.
+  Pcg32(std::uint64_t seed, std::uint64_t stream) : state_(0), inc_((stream << 1u) | 1u) {
+    next_u32();
+    state_ += mix64(seed);
+    next_u32();
+  }
+
+  std::uint32_t next_u32() {
+    const std::uint64_t old = state_;
+    state_ = old * 6364136223846793005ULL + inc_;
+    const auto xorshifted = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
+    const auto rot = static_cast<std::uint32_t>(old >> 59u);
+    return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+  }
+
+  /// Uniform in [0, 1): 53 random bits from two outputs, so that 1 − u is never 0 either.
+  double next_double() {
+    const std::uint64_t hi = next_u32(), lo = next_u32();
+    return static_cast<double>(((hi << 32u) | lo) >> 11u) * 0x1.0p-53;
+  }
+
+ private:
+  std::uint64_t state_, inc_;
+};
+
+}  // namespace bake
+LUMX_NAMESPACE_END
