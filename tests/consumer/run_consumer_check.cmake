@@ -5,7 +5,8 @@
 #  2. checks that the core consumer's link line and its shared-library dependencies name no ray tracer,
 #     task scheduler, glTF/mesh codec, plotting library or command-line parser (Embree, TBB, tinygltf,
 #     Draco, cairo, CLI11), and that it does name liblumx (so the check looks at the real line);
-#  3. asks for an unknown component and for each component this installation lacks: configuring must
+#  3. builds tests/consumer/bake (COMPONENTS bake) and runs it;
+#  4. asks for an unknown component and for each component this installation lacks: configuring must
 #     fail with a message naming it.
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR}/scratch)
@@ -54,7 +55,24 @@ if(libs_lower MATCHES "(${forbidden})")
 endif()
 message(STATUS "core consumer: link line and shared libraries free of ${forbidden}")
 
-# 3. Components the installation does not have.
+# 3. The bake consumer (COMPONENTS bake): traces a luminaire built in code.
+execute_process(COMMAND ${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR}/bake -B ${WORK_DIR}/bake -G "Unix Makefiles"
+                        -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix "-DCMAKE_CXX_FLAGS=${CONSUMER_FLAGS}"
+                        "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_FLAGS}" RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "configuring the bake consumer failed (${rc})")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/bake RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "building the bake consumer failed (${rc})")
+endif()
+execute_process(COMMAND ${WORK_DIR}/bake/consumer RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message(STATUS "${out}${err}")
+if(rc)
+  message(FATAL_ERROR "the bake consumer failed (${rc})")
+endif()
+
+# 4. Components the installation does not have.
 file(READ ${WORK_DIR}/prefix/${INSTALL_LIBDIR}/cmake/lumx/lumxConfig.cmake config)
 set(absent nonesuch)
 if(NOT config MATCHES "lumx_installed_components core bake")
