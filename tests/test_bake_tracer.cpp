@@ -413,3 +413,55 @@ TEST(BakeTracer, LuminaireWithoutFluxIsRefusedByName) {
 }
 
 }  // namespace
+
+namespace {
+
+// A closed white sphere (albedo exactly 1, no port) traps every particle: with roulette switched off, all of
+// them reach the depth cap and are counted there, none leaves.
+TEST(BakeTracer, ClosedWhiteSphereHitsTheDepthCap) {
+  SceneBuilder b("closed white sphere");
+  b.begin_part("wall", b.add_material(lambertian(1.0)));
+  add_sphere(b, 0.1, 24, 48, 0.0, false);
+  b.point_light({0, 0, 0}, 1.0);
+  const Tracer tracer(b.scene());
+  TraceOptions o;
+  o.particles = 2000;
+  o.max_depth = 40;
+  o.roulette_depth = 1000;
+  CollectingSink sink;
+  const TraceCounters c = tracer.trace(o, sink);
+  EXPECT_EQ(c.exited, 0u);
+  EXPECT_EQ(c.roulette_killed, 0u);
+  EXPECT_EQ(c.depth_capped + c.leaked, o.particles);
+  EXPECT_GT(c.depth_capped, o.particles * 9 / 10);
+}
+
+// Internal segments: each starts where the particle was emitted or scattered and ends on the surface it hit
+// (here the glass ball's sphere), and there is one per cast ray that hit something.
+TEST(BakeTracer, SegmentsEndOnTheSurfaceTheyHit) {
+  SceneBuilder b("glass ball");
+  const double radius = 0.05;
+  b.begin_part("ball", b.add_material(smooth_glass(1.5, 0.6, radius)));
+  add_sphere(b, radius, 32, 64, 0.0, true);
+  b.point_light({0, 0, 0}, 1.0);
+  const Tracer tracer(b.scene());
+  TraceOptions o;
+  o.particles = 5000;
+  o.record_segments = true;
+  struct SegmentSink : lumx::bake::ParticleSink {
+    std::vector<lumx::bake::PathSegment> segments;
+    void consume(const ParticleChunk& c) override { segments.insert(segments.end(), c.segments.begin(), c.segments.end()); }
+  } sink;
+  const TraceCounters c = tracer.trace(o, sink);
+  EXPECT_EQ(sink.segments.size(), c.segments - c.exited);
+  ASSERT_FALSE(sink.segments.empty());
+  const double sagitta = radius * (1 - std::cos(lumx::kPi / 32));  // a chord's largest distance from the sphere
+  for (const auto& s : sink.segments) {
+    const glm::dvec3 end = glm::dvec3(s.origin) + double(s.length_m) * glm::dvec3(s.direction);
+    ASSERT_NEAR(glm::length(end), radius, sagitta + 1e-5);
+    ASSERT_GT(s.length_m, 0.0f);
+    ASSERT_LE(luminance(glm::dvec3(s.flux_lm)), tracer.total_flux_lm() / o.particles * (1 + 1e-6));
+  }
+}
+
+}  // namespace

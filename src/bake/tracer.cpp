@@ -86,6 +86,8 @@ struct Tracer::Impl {
   EmitterSampler emitters;
   double offset_scale = 1e-6;              // self-intersection offset, m (from the scene's extent)
 
+  std::vector<MediumStack> emitter_media;  // per emitter: the solids its light starts in (innermost on top)
+
   explicit Impl(const LuminaireScene& s) : scene(s), emitters(s) {
     for (const Material& m : s.materials) {
       bsdfs.emplace_back(m);
@@ -125,6 +127,80 @@ struct Tracer::Impl {
       rtcReleaseGeometry(geom);
     }
     rtcCommitScene(rtc_scene);
+
+    // Which solids each emitter sits in (a point light inside a glass ball starts inside the glass).
+    emitter_media.resize(s.emitters.size());
+    for (std::size_t e = 0; e < s.emitters.size(); ++e) {
+      const Emitter& em = s.emitters[e];
+      if (em.kind == EmitterKind::surface) {
+        const Part& part = s.parts.at(em.part);
+        if (part.triangle_count == 0) continue;
+        const std::uint32_t t = part.first_triangle;
+        const glm::dvec3 a = s.positions[s.indices[3 * t]], b = s.positions[s.indices[3 * t + 1]],
+                         c = s.positions[s.indices[3 * t + 2]];
+        const glm::dvec3 n = glm::cross(b - a, c - a);
+        if (!(glm::length(n) > 0.0)) continue;
+        const glm::dvec3 centroid = (a + b + c) / 3.0, nn = glm::normalize(n);
+        emitter_media[e] = media_at(offset_origin(centroid, nn, nn), std::uint32_t(part.material));
+      } else {
+        emitter_media[e] = media_at(glm::dvec3(em.to_world[3]), std::uint32_t(-1));
+      }
+    }
+  }
+
+  /// The volume parts enclosing point p, innermost on top: walk a ray from p and note the solids it leaves
+  /// through their inside (back) face before entering them. `skip_material` marks the emitter's own surface.
+  MediumStack media_at(const glm::dvec3& p, std::uint32_t skip_material) const {
+    MediumStack found;
+    std::vector<std::uint32_t> entered;
+    const glm::dvec3 d = glm::normalize(glm::dvec3(0.2718281828, 0.3141592653, 0.9));  // off every axis
+    glm::dvec3 o = p;
+    for (int step = 0; step < 256; ++step) {
+      RTCRayHit rh = cast(o, d);
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+      const std::uint32_t tri = rh.hit.primID, part = scene.triangle_part[tri];
+      const glm::dvec3 a = scene.positions[scene.indices[3 * tri]], b = scene.positions[scene.indices[3 * tri + 1]],
+                       c = scene.positions[scene.indices[3 * tri + 2]];
+      glm::dvec3 ng = glm::cross(b - a, c - a);
+      const glm::dvec3 hit = o + double(rh.ray.tfar) * d;
+      if (glm::length(ng) > 0.0) {
+        ng = glm::normalize(ng);
+        if (part_volume[part] && scene.parts[part].material != skip_material) {
+          const auto it = std::find(entered.begin(), entered.end(), part);
+          if (glm::dot(d, ng) < 0.0)
+            entered.push_back(part);
+          else if (it != entered.end())
+            entered.erase(it);
+          else if (found.size < MediumStack::kCapacity)
+            found.part[found.size++] = part;  // outward order: innermost first
+        }
+        o = offset_origin(hit, ng, d);
+      } else {
+        o = hit + offset_scale * d;
+      }
+    }
+    MediumStack stack;  // innermost on top
+    for (int i = found.size - 1; i >= 0; --i) stack.push(found.part[i]);
+    return stack;
+  }
+
+  RTCRayHit cast(const glm::dvec3& origin, const glm::dvec3& direction) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    RTCRayHit rh;
+    rh.ray.org_x = float(origin.x), rh.ray.org_y = float(origin.y), rh.ray.org_z = float(origin.z);
+    rh.ray.dir_x = float(direction.x), rh.ray.dir_y = float(direction.y), rh.ray.dir_z = float(direction.z);
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.time = 0.0f;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_scene, &context, &rh);
+    return rh;
   }
 
   ~Impl() {
@@ -166,25 +242,13 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
   glm::dvec3 position = e.position;
   glm::dvec3 direction = e.direction;
   glm::dvec3 origin = e.has_surface ? offset_origin(e.position, e.surface_normal, e.direction) : e.position;
-  MediumStack media;
+  // Rayset rays start anywhere: find their solids per particle; other emitters sit in fixed ones.
+  MediumStack media = scene.emitters[e.emitter].kind == EmitterKind::rayset ? media_at(e.position, std::uint32_t(-1))
+                                                                           : emitter_media[e.emitter];
   std::uint32_t bounces = 0;
 
   for (;;) {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    RTCRayHit rh;
-    rh.ray.org_x = float(origin.x), rh.ray.org_y = float(origin.y), rh.ray.org_z = float(origin.z);
-    rh.ray.dir_x = float(direction.x), rh.ray.dir_y = float(direction.y), rh.ray.dir_z = float(direction.z);
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.time = 0.0f;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(rtc_scene, &context, &rh);
+    const RTCRayHit rh = cast(origin, direction);
     c.segments += 1;
 
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
