@@ -4,6 +4,11 @@
 #pragma once
 
 #include <lumx/apl/builder.h>
+#include <lumx/io/bundle_io.h>
+#include <lumx/rays/rayset.h>
+#include <lumx/volume/radiance_volume.h>
+
+#include <map>
 
 #include <cstddef>
 #include <string>
@@ -30,6 +35,17 @@ struct BuildArgs {
 };
 
 int run_build(const BuildArgs& a);
+
+/// What a bundle gets beside its levels and far field: a radiance volume, more attachments, provenance.
+struct BundleExtras {
+  const lumx::RadianceVolume* volume = nullptr;
+  std::vector<lumx::BundleAttachment> attachments;
+  std::map<std::string, std::string> provenance;
+};
+
+/// `lumx build`'s work on rays already open (a.rays names them in messages and provenance): levels, error
+/// tables on held-out rays, the far field, the bundle at a.out. Throws lumx::Error; returns 0.
+int build_bundle(lumx::RaySource& rays, const BuildArgs& a, const BundleExtras& extras);
 
 /// The builder options a bundle was made with, as the JSON `lumx build` stores in its provenance
 /// ("build_options"), and back; `lumx eval` rebuilds from half of the source rays with them.

@@ -4,6 +4,7 @@
 //
 // Subcommands and their one-line help come from one table (kCommands); CLI11 renders `lumx --help`,
 // `lumx <cmd> --help` and usage errors (to stderr, exit status 2 or CLI11's code) from it.
+#include "bake_command.h"
 #include "build_command.h"
 #include "commands.h"
 #include "eval_commands.h"
@@ -28,6 +29,7 @@ lumx_cli::CheckArgs g_check;
 lumx_cli::ConvertArgs g_convert;
 lumx_cli::PlotArgs g_plot;
 lumx_cli::BuildArgs g_build;
+lumx_cli::BakeArgs g_bake;
 lumx_cli::EvalArgs g_eval;
 
 /// Refuses nan/inf for angle options (CLI11's number parsing accepts them).
@@ -148,6 +150,30 @@ const Command kCommands[] = {
                                                   "is the same for any count)")
            ->check(CLI::Range(0u, 256u));
        c.callback([&st] { st = lumx_cli::run_build(g_build); });
+     }},
+    {"bake", "Bake a glTF 2.0 luminaire (.glb/.gltf, Draco allowed) into a bundle: trace light particles from its "
+             "emitters through its geometry, then build APL levels and error tables from the exits (as lumx build), "
+             "the radiance volume from the internal segments, the far field as IES/EULUMDAT, and ship the luminaire",
+     [](CLI::App& c, int& st) {
+       c.add_option("luminaire", g_bake.luminaire, "glTF 2.0 luminaire (.glb or .gltf)")->required();
+       c.add_option("output", g_bake.out, "bundle folder to write")->required();
+       c.add_option("--particles", g_bake.particles, "particles to trace (default 1000000)")
+           ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+       c.add_option("--seed", g_bake.seed, "seed of the particles' random streams (default 1)");
+       c.add_option("--volume-voxels", g_bake.volume_voxels,
+                    "radiance volume voxels, about (default 32768 = 32^3; 0: no volume)")
+           ->check(CLI::Range(0, 1 << 24));
+       c.add_option("--max-depth", g_bake.max_depth, "scattering events before a particle is dropped (default 256)")
+           ->check(CLI::Range(1, 100000));
+       c.add_option("--rays-out", g_bake.rays_out, "also keep the exits as an IES TM-25 rayset (a virtual near-field "
+                                                   "goniophotometer)");
+       c.add_option("--levels", g_bake.build.levels, "APLs per level, increasing (default 1 8 64 256 512)");
+       c.add_flag("--no-eval", g_bake.build.no_eval, "skip the error evaluation (no error tables)");
+       c.add_flag("--progress", g_bake.build.progress, "show the progress bar even when stderr is not a terminal");
+       c.add_option("--threads", g_bake.build.threads, "threads (default: every core; the bundle is the same for "
+                                                       "any count)")
+           ->check(CLI::Range(0u, 256u));
+       c.callback([&st] { st = lumx_cli::run_bake(g_bake); });
      }},
     {"eval", "Irradiance of a bundle at given points (--points: 'x y z nx ny nz' per line, one value per line "
              "out, lx or W/m^2), or its error against a rayset (--rays: relative RMSE, eq. 5.1, per level and the "

@@ -49,12 +49,15 @@ bool TracedRaySource::refill() {
     TraceOptions o = options_;
     o.first_particle = next_particle_;
     o.particles = std::min(batch_, options_.particles - next_particle_);
-    if (first_pass_complete_) o.record_segments = false;
     BatchSink sink;
     sink.rays = &pending_;
-    sink.observer = first_pass_complete_ ? nullptr : observer_;
+    // Each particle reaches the observer once, even when a pass is cut short by rewind().
+    const bool observe = observer_ && o.first_particle >= observed_until_;
+    sink.observer = observe ? observer_ : nullptr;
+    if (!observe) o.record_segments = false;
     pass_counters_.add(tracer_.trace(o, sink));
     next_particle_ += o.particles;
+    if (observe) observed_until_ = next_particle_;
   }
   if (!pending_.empty()) return true;
   if (!first_pass_complete_) {

@@ -20,7 +20,7 @@ class TracedRaySource : public RaySource {
  public:
   /// `options.particles` particles in all (first_particle must be 0), traced `batch_particles` at a time.
   /// `observer`, if given, receives every traced chunk in order (segments too, when
-  /// options.record_segments) during the first pass only — e.g. to fill a radiance volume.
+  /// options.record_segments) once: each particle the first time it is traced — e.g. to fill a radiance volume.
   TracedRaySource(const Tracer& tracer, const TraceOptions& options, std::uint64_t batch_particles = 1u << 17,
                   ParticleSink* observer = nullptr);
 
@@ -41,6 +41,7 @@ class TracedRaySource : public RaySource {
   ParticleSink* observer_;
   RaysetInfo info_;
   std::uint64_t next_particle_ = 0;
+  std::uint64_t observed_until_ = 0;  // particles [0, observed_until_) were shown to the observer
   RayChunk pending_;
   std::size_t pending_position_ = 0;
   TraceCounters counters_, pass_counters_;

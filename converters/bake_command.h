@@ -1,0 +1,25 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// converters/bake_command.h — `lumx bake LUMINAIRE BUNDLE`: a luminaire's geometry in, a bundle out.
+#pragma once
+
+#include "build_command.h"
+
+#include <cstdint>
+#include <string>
+
+namespace lumx_cli {
+
+struct BakeArgs {
+  std::string luminaire, out;
+  std::uint64_t particles = 1000000;  ///< --particles
+  std::uint64_t seed = 1;             ///< --seed
+  int volume_voxels = 32768;          ///< --volume-voxels (0: no radiance volume)
+  std::string rays_out;               ///< --rays-out FILE.tm25ray: the exits as an IES TM-25 rayset
+  int max_depth = 256;                ///< --max-depth
+  BuildArgs build;                    ///< levels, error tables, far field, threads (as `lumx build`)
+};
+
+int run_bake(BakeArgs a);
+
+}  // namespace lumx_cli
