@@ -12,9 +12,17 @@
 // Transport. TransportMode::importance is the adjoint (particle) direction: the particle travels along
 // −wo into the surface and leaves along wi, and eval() returns f*(wo, wi) = f(wi, wo), without the 1/η²
 // radiance scaling on refraction (Veach 1997 §5.2). TransportMode::radiance is the usual f(wo, wi).
+//
+// Model (glTF 2.0 Appendix B with KHR_materials_{ior,specular,transmission,diffuse_transmission,volume}):
+// metal and dielectric share one GGX reflection lobe; the dielectric's base is a Lambertian reflector /
+// diffuse transmitter and, with weight `transmission`, a rough dielectric interface (Walter et al. 2007)
+// that refracts (volume) or passes light straight through (thin-walled). docs/bsdf.md states the lobe
+// weights and the sampling mixture; the scattering kernel is defined for the particle arriving from wo
+// (importance), and radiance mode is its adjoint f(wo, wi) = f*(wi, wo).
 #pragma once
 
 #include <lumx/bake/material.h>
+#include <lumx/bake/microfacet.h>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -49,9 +57,46 @@ class Bsdf {
   bool has_delta_lobe() const { return has_delta_; }
   const Material& material() const { return material_; }
 
+  /// GGX α below which the specular lobes are treated as smooth (Dirac) lobes.
+  static constexpr double kSmoothAlpha = 1e-3;
+  /// |ior − 1| below which a volume's interface is index-matched: it neither reflects nor bends light.
+  static constexpr double kIndexMatchedTolerance = 1e-3;
+
  private:
+  struct LobeProbabilities {
+    double specular = 0.0;      ///< GGX / mirror reflection (metal and the opaque dielectric's coat)
+    double interface = 0.0;     ///< the transmissive dielectric interface (reflects or transmits)
+    double diffuse = 0.0;       ///< Lambertian reflection
+    double diffuse_transmission = 0.0;  ///< Lambertian transmission to the other side
+  };
+
+  // Fresnel of the dielectric layer seen from outside, per channel, before the specular factor.
+  Rgb dielectric_fresnel(double cos_theta) const;
+  double dielectric_fresnel_max(double cos_theta) const;
+  Rgb metal_fresnel(double cos_theta) const;
+  double diffuse_coupling(double cos_o, double cos_i) const;
+  double interface_reflect_probability(double cos_theta) const;
+  LobeProbabilities lobe_probabilities(double cos_o) const;
+
+  Rgb kernel(const glm::dvec3& wo, const glm::dvec3& wi) const;
+  Rgb kernel_inside(const glm::dvec3& wo, const glm::dvec3& wi) const;
+  double pdf_inside(const glm::dvec3& wo, const glm::dvec3& wi) const;
+  std::optional<BsdfSample> sample_inside(const glm::dvec3& wo, double u_lobe, const glm::dvec2& u,
+                                          TransportMode mode) const;
+  std::optional<BsdfSample> finish_sample(const glm::dvec3& wo, const glm::dvec3& wi, TransportMode mode) const;
+
   Material material_;
   bool has_delta_ = false;
+  GgxDistribution ggx_{1.0};
+  bool smooth_ = false;
+  bool index_matched_ = false;
+  double eta_ = 1.5;          ///< sanitised ior (η of the solid against the outside)
+  double metallic_ = 0.0, transmission_ = 0.0, specular_ = 1.0, diffuse_transmission_ = 0.0;
+  Rgb base_{1.0}, diffuse_transmission_color_{1.0};
+  Rgb dielectric_f0_{0.04};   ///< min(F0(ior) · specular_color, 1) per channel
+  double plain_f0_ = 0.04;    ///< F0(ior), the bare interface's normal reflectance
+  double base_max_ = 1.0;     ///< max channel of the base colour (transmission tint)
+  double coupling_norm_ = 1.0;  ///< 1 − specular · 2∫ F̂(μ) μ dμ (diffuse coupling normaliser)
 };
 
 }  // namespace bake
