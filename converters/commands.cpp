@@ -57,6 +57,7 @@ void print_version() {
 
 int run_info(const InfoArgs& a) {
   if (is_bundle_path(a.file)) return run_bundle_info(a);
+  if (is_luminaire_path(a.file)) return run_luminaire_info(a);
   if (is_rayset_path(a.file)) return run_rayset_info(a);
   return guarded(a.file, [&] {
     std::vector<lumx::Diagnostic> warnings;
@@ -145,6 +146,8 @@ int run_check(const CheckArgs& a) {
     try {
       if (is_bundle_path(file)) {
         findings = lumx::check_bundle(file);
+      } else if (is_luminaire_path(file)) {
+        findings = check_luminaire_file(file);
       } else if (is_rayset_path(file)) {
         findings = check_rayset(file);
       } else {

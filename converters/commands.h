@@ -61,6 +61,13 @@ bool is_rayset_path(const std::string& path);
 int run_rayset_info(const InfoArgs& a);
 std::vector<lumx::Diagnostic> check_rayset(const std::string& path);
 
+/// True when `path` names a glTF 2.0 luminaire (.gltf or .glb, by extension; luminaire_commands.cpp).
+bool is_luminaire_path(const std::string& path);
+/// Luminaire variants: info (parts, material models, emitters with flux, bounding box, warnings) and the
+/// findings of reading and checking the scene (lumx::bake::check_luminaire).
+int run_luminaire_info(const InfoArgs& a);
+std::vector<lumx::Diagnostic> check_luminaire_file(const std::string& path);
+
 /// Prints the library, ABI and file-format versions.
 void print_version();
 

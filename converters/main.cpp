@@ -47,9 +47,10 @@ const Command kCommands[] = {
     {"info", "Summarise a photometry file (IES or EULUMDAT: grid, flux, peak, beam/field angles), a bundle "
              "(levels, APLs, map resolutions, flux and bytes per level, volume grid) or a rayset (TM-25, "
              "LightTools, Zemax, plain text: rays, flux in the header and summed, bounding box and sphere, "
-             "spectrum, text fields)",
+             "spectrum, text fields) or a glTF luminaire (.gltf, .glb: parts, material models, emitters and "
+             "their flux, bounding box)",
      [](CLI::App& c, int& st) {
-       c.add_option("file", g_info.file, "IES (.ies) or EULUMDAT (.ldt) file, a bundle folder, or a rayset")
+       c.add_option("file", g_info.file, "IES (.ies) or EULUMDAT (.ldt) file, a bundle folder, a rayset, or a glTF luminaire")
            ->required();
        c.add_flag("--json", g_info.json, "print the facts as JSON");
        c.callback([&st] { st = lumx_cli::run_info(g_info); });
@@ -57,7 +58,8 @@ const Command kCommands[] = {
     {"check", "Validate files or bundles strictly: 'FILE: OK' or located findings; exit status 1 on errors. "
               "Bundles: manifest rules, every payload's size and SHA-256, maps finite and non-negative, "
               "flux equal across levels within 0.1 %. Raysets: every ray read and checked (header, counts, "
-              "directions, fluxes); the header total against the rays' sum is a warning",
+              "directions, fluxes); the header total against the rays' sum is a warning. glTF luminaires: "
+              "the reader's checks, bad triangles, open volumes, emitters without flux",
      [](CLI::App& c, int& st) {
        c.add_option("files", g_check.files, "files or bundle folders to check")->required();
        c.add_flag("--json", g_check.json, "print findings as JSON");

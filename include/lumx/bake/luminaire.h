@@ -27,6 +27,13 @@ struct Part {
   std::uint32_t material = 0;        ///< index into LuminaireScene::materials
   std::uint32_t first_triangle = 0;  ///< triangles [first_triangle, first_triangle + triangle_count)
   std::uint32_t triangle_count = 0;
+  std::int32_t node = -1;       ///< glTF node index that placed it (-1: not from glTF)
+  std::int32_t mesh = -1;       ///< glTF mesh index (-1: not from glTF)
+  std::int32_t primitive = -1;  ///< primitive index within the mesh (-1: not from glTF)
+  /// Every edge is shared by exactly two of the part's triangles once equal positions are welded (a closed
+  /// surface, as a refracting volume needs). Set by the glTF reader with part_is_closed()
+  /// (lumx/bake/luminaire_check.h); false for parts built in code unless they set it.
+  bool closed = false;
 };
 
 enum class EmitterKind {
