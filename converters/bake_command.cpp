@@ -87,7 +87,9 @@ int run_bake(BakeArgs a) {
     const std::string rays_path = keep_rays ? a.rays_out : a.out + ".rays.tm25ray";
     lumx::RaysetInfo info = traced.info();
     info.text["creator"] = std::string("lumx ") + lumx::kLibraryVersion + " bake";
-    lumx::write_tm25(rays_path, info, traced);
+    lumx::Tm25WriteOptions tm25;
+    tm25.header_flux_from_rays = true;  // the exit flux, known once every particle is traced
+    lumx::write_tm25(rays_path, info, traced, tm25);
     bar.done();
     const double trace_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     const lumx::bake::TraceCounters& c = traced.counters();
@@ -126,6 +128,7 @@ int run_bake(BakeArgs a) {
     rro.warnings = [](const lumx::Diagnostic& d) { print_diag(d); };
     auto rays = lumx::open_rayset(rays_path, rro);
     a.build.rays = rays_path;
+    a.build.out = a.out;
     int status = 0;
     try {
       status = build_bundle(*rays, a.build, extras);

@@ -89,6 +89,9 @@ RayChunk read_all_rays(RaySource& rays, std::uint64_t max_rays);
 
 struct Tm25WriteOptions {
   std::size_t chunk_rays = 65536;
+  /// The header's total flux (for info.quantity) is the sum of the rays written, not info.header_flux: for
+  /// rays whose total is known only once they are all streamed (a trace's exits).
+  bool header_flux_from_rays = false;
 };
 
 /// Writes `rays` (rewound first) as an IES TM-25-13 file, atomically: streamed into a temporary file in

@@ -130,6 +130,7 @@ void write_tm25(const std::string& path, const RaysetInfo& info, RaySource& rays
   RayChunk c;
   std::vector<unsigned char> buf;
   std::uint64_t n = 0;
+  double flux_sum = 0.0;
   int with_wavelength = -1;  // decided by the first chunk
   float lam_min = INFINITY, lam_max = -INFINITY;
   const std::size_t chunk = std::max<std::size_t>(options.chunk_rays, 1);
@@ -162,6 +163,7 @@ void write_tm25(const std::string& path, const RaysetInfo& info, RaySource& rays
         fail("ray flux", ray() + "flux " + g(v[6]) + " is negative or not finite");
       unsigned char* p = buf.data() + i * 4 * cols;
       for (int k = 0; k < 7; ++k) put_f32(p + 4 * k, v[k]);
+      flux_sum += double(v[6]);
       if (cols == 8) {
         const float lam = c.wavelength_nm[i];
         if (!(lam > 0 && std::isfinite(lam)))
@@ -212,6 +214,12 @@ void write_tm25(const std::string& path, const RaysetInfo& info, RaySource& rays
   put_i32(at(268), with_wavelength == 1 ? 1 : 0);  // wavelength
   put_i32(at(272), radiometric ? 0 : 1);           // luminous flux
   out.pwrite_at(20, h, sizeof h);
+  if (options.header_flux_from_rays) {
+    if (!(flux_sum <= std::numeric_limits<float>::max())) fail("header flux", "the rays' total flux exceeds a float");
+    unsigned char f[4];
+    put_f32(f, static_cast<float>(flux_sum));
+    out.pwrite_at(radiometric ? 16 : 12, f, sizeof f);
+  }
   out.commit();
 }
 
