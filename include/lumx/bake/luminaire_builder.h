@@ -89,9 +89,8 @@ class LuminaireBuilder {
   void disk(const glm::dmat4& frame, double radius, int segments, bool up = true) {
     const glm::dvec3 c = point(frame, {0, 0, 0});
     for (int i = 0; i < segments; ++i) {
-      const double a0 = 2 * kPi * i / segments, a1 = 2 * kPi * (i + 1) / segments;
-      const glm::dvec3 p0 = point(frame, {radius * std::cos(a0), radius * std::sin(a0), 0});
-      const glm::dvec3 p1 = point(frame, {radius * std::cos(a1), radius * std::sin(a1), 0});
+      const glm::dvec3 p0 = point(frame, radius * around(double(i) / segments));
+      const glm::dvec3 p1 = point(frame, radius * around(double(i + 1) / segments));
       if (up)
         flat_triangle(c, p0, p1);
       else
@@ -105,8 +104,9 @@ class LuminaireBuilder {
               bool outward = true) {
     const double t0 = port_half_angle;
     auto dir = [&](double u, double v) {  // u: longitude, v: latitude from the pole down
-      const double th = t0 + (kPi - t0) * v, ph = 2 * kPi * u;
-      return glm::dvec3(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+      if (v >= 1.0) return glm::dvec3(0.0, 0.0, -1.0);  // the pole exactly, whatever the longitude
+      const double th = t0 + (kPi - t0) * v;
+      return std::sin(th) * around(u) + glm::dvec3(0.0, 0.0, std::cos(th));
     };
     // ∂/∂u × ∂/∂v points inwards for this parametrisation; swap the roles for the outward front.
     if (outward)
@@ -121,10 +121,8 @@ class LuminaireBuilder {
   /// optional flat caps facing away from the inside (closed tube: a solid for volume materials).
   void cylinder(const glm::dmat4& frame, double radius, double height, int sectors, int rows = 1,
                 bool outward = true, bool caps = false) {
-    auto p = [&](double u, double v) {
-      return point(frame, {radius * std::cos(2 * kPi * u), radius * std::sin(2 * kPi * u), height * v});
-    };
-    auto n = [&](double u, double) { return normal(frame, {std::cos(2 * kPi * u), std::sin(2 * kPi * u), 0.0}); };
+    auto p = [&](double u, double v) { return point(frame, radius * around(u) + glm::dvec3(0.0, 0.0, height * v)); };
+    auto n = [&](double u, double) { return normal(frame, around(u)); };
     if (outward)
       surface(p, n, sectors, rows);
     else
@@ -160,12 +158,12 @@ class LuminaireBuilder {
   /// normals) facing the focus.
   void paraboloid(const glm::dmat4& frame, double focal_length, double rim_radius, int rings, int sectors) {
     auto p = [&](double u, double v) {  // u: radius fraction, v: angle fraction
-      const double rho = rim_radius * u, ph = 2 * kPi * v;
-      return point(frame, {rho * std::cos(ph), rho * std::sin(ph), rho * rho / (4 * focal_length) - focal_length});
+      const double rho = rim_radius * u;
+      return point(frame, rho * around(v) + glm::dvec3(0.0, 0.0, rho * rho / (4 * focal_length) - focal_length));
     };
     auto n = [&](double u, double v) {
-      const double rho = rim_radius * u, ph = 2 * kPi * v;
-      return normal(frame, {-rho * std::cos(ph) / (2 * focal_length), -rho * std::sin(ph) / (2 * focal_length), 1.0});
+      const double rho = rim_radius * u;
+      return normal(frame, -rho / (2 * focal_length) * around(v) + glm::dvec3(0.0, 0.0, 1.0));
     };
     surface(p, n, rings, sectors);
   }
@@ -191,6 +189,11 @@ class LuminaireBuilder {
   }
 
  private:
+  /// (cos 2πf, sin 2πf, 0), with f = 1 giving exactly f = 0's point so that seams and fans weld.
+  static glm::dvec3 around(double f) {
+    const double a = 2 * kPi * (f >= 1.0 ? 0.0 : f);
+    return {std::cos(a), std::sin(a), 0.0};
+  }
   static glm::dvec3 point(const glm::dmat4& frame, const glm::dvec3& p) { return glm::dvec3(frame * glm::dvec4(p, 1.0)); }
   static glm::dvec3 normal(const glm::dmat4& frame, const glm::dvec3& n) {
     return glm::normalize(glm::transpose(glm::inverse(glm::dmat3(frame))) * n);
