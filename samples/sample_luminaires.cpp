@@ -6,6 +6,7 @@
 //   sample_luminaires OUT_DIR
 //     troffer.glb        three T8 tubes (3 × 3000 lm) in a white housing behind a prismatic refractor, 1.2 × 0.6 m
 //     pendant.glb        an "artichoke": one opal bulb (1500 lm) among 72 copper leaves in six tiers
+//                        (meshes Draco-compressed: KHR_draco_mesh_compression)
 //     shape_sorter.glb   four coloured emitters in a white box with a circle, a square, a triangle and a star cut out
 //     chandelier.glb     five candle emitters under rough-glass shades on brass arms around a glass stem
 //
@@ -231,7 +232,9 @@ int main(int argc, char** argv) {
         {"troffer.glb", troffer()}, {"pendant.glb", pendant()}, {"shape_sorter.glb", shape_sorter()},
         {"chandelier.glb", chandelier()}};
     for (const auto& [name, scene] : all) {
-      lumx::bake::write_gltf_luminaire(scene, (dir / name).string());
+      lumx::bake::GltfWriteOptions options;
+      options.draco = std::string(name) == "pendant.glb";
+      lumx::bake::write_gltf_luminaire(scene, (dir / name).string(), options);
       double flux = 0.0;
       for (const auto& e : scene.emitters) flux += lumx::bake::emitter_flux_lm(scene, e);
       std::printf("%-18s %6zu triangles, %zu parts, %zu emitters, %.0f lm\n", (dir / name).string().c_str(),

@@ -6,6 +6,9 @@
 #include <lumx/io/atomic_file.h>
 #include <lumx/io/photometry_io.h>
 
+#include <draco/compression/decode.h>
+#include <draco/compression/encode.h>
+#include <draco/mesh/mesh.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -59,6 +62,69 @@ struct BufferBuilder {
     return int(accessors.size()) - 1;
   }
 };
+
+/// One mesh as a KHR_draco_mesh_compression primitive: the compressed bytes in a bufferView, and accessors
+/// that state what decoding gives (counts, and the POSITION box) without data of their own.
+json draco_primitive(BufferBuilder& buffer, const std::vector<float>& positions, const std::vector<float>& normals,
+                     const std::vector<std::uint32_t>& indices, const GltfWriteOptions& o, const std::string& path,
+                     const std::string& where) {
+  draco::Mesh mesh;
+  const std::size_t points = positions.size() / 3;
+  mesh.set_num_points(std::uint32_t(points));
+  auto add = [&](draco::GeometryAttribute::Type type, const std::vector<float>& values) {
+    draco::GeometryAttribute a;
+    a.Init(type, nullptr, 3, draco::DT_FLOAT32, false, sizeof(float) * 3, 0);
+    const int id = mesh.AddAttribute(a, true, std::uint32_t(points));
+    for (std::size_t i = 0; i < points; ++i)
+      mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(std::uint32_t(i)), &values[3 * i]);
+    return int(mesh.attribute(id)->unique_id());
+  };
+  const int position_id = add(draco::GeometryAttribute::POSITION, positions);
+  const int normal_id = normals.empty() ? -1 : add(draco::GeometryAttribute::NORMAL, normals);
+  for (std::size_t t = 0; t < indices.size() / 3; ++t) {
+    draco::Mesh::Face f;
+    for (int k = 0; k < 3; ++k) f[k] = draco::PointIndex(indices[3 * t + k]);
+    mesh.AddFace(f);
+  }
+  draco::Encoder encoder;
+  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, o.draco_position_bits);
+  encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, o.draco_normal_bits);
+  draco::EncoderBuffer encoded;
+  const draco::Status status = encoder.EncodeMeshToBuffer(mesh, &encoded);
+  if (!status.ok()) throw_at_field(path, where, std::string("Draco encoding failed: ") + status.error_msg());
+  // The accessors describe the decoded mesh (its point count and quantised box), so decode once.
+  draco::DecoderBuffer in;
+  in.Init(encoded.data(), encoded.size());
+  draco::Decoder decoder;
+  auto decoded = decoder.DecodeMeshFromBuffer(&in);
+  if (!decoded.ok()) throw_at_field(path, where, "Draco data written cannot be decoded");
+  const draco::Mesh& back = *decoded.value();
+  const draco::PointAttribute* pa = back.GetAttributeByUniqueId(std::uint32_t(position_id));
+  std::vector<float> lo(3, std::numeric_limits<float>::infinity()), hi(3, -std::numeric_limits<float>::infinity());
+  for (std::uint32_t i = 0; i < back.num_points(); ++i) {
+    float v[3];
+    pa->GetMappedValue(draco::PointIndex(i), v);
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+  }
+  const int view = buffer.view(encoded.data(), encoded.size(), 0);
+  auto accessor = [&](json a) {
+    buffer.accessors.push_back(std::move(a));
+    return int(buffer.accessors.size()) - 1;
+  };
+  json attributes = {{"POSITION", accessor({{"componentType", kFloat}, {"count", back.num_points()}, {"type", "VEC3"},
+                                            {"min", lo}, {"max", hi}})}};
+  json draco_attributes = {{"POSITION", position_id}};
+  if (normal_id >= 0) {
+    attributes["NORMAL"] = accessor({{"componentType", kFloat}, {"count", back.num_points()}, {"type", "VEC3"}});
+    draco_attributes["NORMAL"] = normal_id;
+  }
+  const int index_accessor =
+      accessor({{"componentType", kUnsignedInt}, {"count", 3 * back.num_faces()}, {"type", "SCALAR"}});
+  return {{"attributes", attributes},
+          {"indices", index_accessor},
+          {"mode", 4},
+          {"extensions", {{"KHR_draco_mesh_compression", {{"bufferView", view}, {"attributes", draco_attributes}}}}}};
+}
 
 std::string base64(const std::string& in) {
   static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -153,13 +219,16 @@ void write_gltf_luminaire(const LuminaireScene& scene, const std::string& path, 
         indices.push_back(it->second);
       }
     if (indices.empty()) continue;
-    json attributes = {{"POSITION", buffer.vec3_accessor(positions, true)}};
-    if (!normals.empty()) attributes["NORMAL"] = buffer.vec3_accessor(normals, false);
-    meshes.push_back({{"name", part.name},
-                      {"primitives", json::array({{{"attributes", attributes},
-                                                   {"indices", buffer.index_accessor(indices)},
-                                                   {"material", part.material},
-                                                   {"mode", 4}}})}});
+    json primitive;
+    if (options.draco) {
+      primitive = draco_primitive(buffer, positions, normals, indices, options, path, "/meshes/" + std::to_string(meshes.size()));
+    } else {
+      json attributes = {{"POSITION", buffer.vec3_accessor(positions, true)}};
+      if (!normals.empty()) attributes["NORMAL"] = buffer.vec3_accessor(normals, false);
+      primitive = {{"attributes", attributes}, {"indices", buffer.index_accessor(indices)}, {"mode", 4}};
+    }
+    primitive["material"] = part.material;
+    meshes.push_back({{"name", part.name}, {"primitives", json::array({primitive})}});
     nodes.push_back({{"name", part.name}, {"mesh", meshes.size() - 1}});
     scene_nodes.push_back(nodes.size() - 1);
   }
@@ -213,6 +282,10 @@ void write_gltf_luminaire(const LuminaireScene& scene, const std::string& path, 
   if (!punctual.empty()) extensions["KHR_lights_punctual"] = {{"lights", punctual}};
   if (!ies_profiles.empty()) extensions["EXT_lights_ies"] = {{"lights", ies_profiles}};
   if (!extensions.empty()) doc["extensions"] = extensions;
+  if (options.draco && !meshes.empty()) {
+    used.push_back("KHR_draco_mesh_compression");
+    doc["extensionsRequired"] = json::array({"KHR_draco_mesh_compression"});
+  }
   if (!used.empty()) doc["extensionsUsed"] = used;
   if (!buffer.bytes.empty()) {
     while (buffer.bytes.size() % 4) buffer.bytes.push_back('\0');

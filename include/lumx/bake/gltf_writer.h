@@ -6,7 +6,8 @@
 // materials with the KHR_materials_{ior,specular,transmission,diffuse_transmission,volume,emissive_strength}
 // extensions where they differ from glTF's defaults, point and spot emitters as KHR_lights_punctual on nodes
 // placed by their transform, IES emitters as EXT_lights_ies with the profile embedded (bufferView, LM-63-2019
-// text). Rayset emitters are refused (their file lives outside the glTF). Written atomically.
+// text). Rayset emitters are refused (their file lives outside the glTF). Meshes may be Draco-compressed.
+// Written atomically.
 #pragma once
 
 #include <lumx/bake/luminaire.h>
@@ -19,6 +20,12 @@ namespace bake {
 struct GltfWriteOptions {
   bool binary = true;  ///< .glb (one BIN chunk); false: .gltf JSON with the buffer as a base64 data URI
   std::string generator = "lumx";  ///< asset.generator
+  /// Compress every mesh with KHR_draco_mesh_compression (required by the file then): positions quantised
+  /// to `draco_position_bits` over each mesh's box, normals to `draco_normal_bits` (glTF-Transform's
+  /// defaults, 14 and 10: 0.06 mm steps over a 1 m box).
+  bool draco = false;
+  int draco_position_bits = 14;
+  int draco_normal_bits = 10;
 };
 
 /// Throws lumx::Error (naming the path and the part or emitter) for what glTF cannot hold.
