@@ -97,6 +97,10 @@ class Bsdf {
   double plain_f0_ = 0.04;    ///< F0(ior), the bare interface's normal reflectance
   double base_max_ = 1.0;     ///< max channel of the base colour (transmission tint)
   double coupling_norm_ = 1.0;  ///< 1 − specular · 2∫ F̂(μ) μ dμ (diffuse coupling normaliser)
+  double coupling_margin_ = 1.0;  ///< κ: 1 − kRoughCouplingMargin · specular for rough layers, else 1
+  /// Share of the diffuse coupling a rough specular layer withholds (covers the visible-microfacet Fresnel
+  /// average exceeding the macro-normal Fresnel; see src/bake/bsdf.cpp).
+  static constexpr double kRoughCouplingMargin = 0.005;
 };
 
 }  // namespace bake
