@@ -28,14 +28,14 @@ namespace {
 constexpr int kChi2Samples = 100000;
 constexpr int kChi2CosBins = 10, kChi2PhiBins = 20;
 constexpr int kFurnaceSamples = 100000;
-constexpr double kQuadratureTolerance = 1e-5;  // relative, per cell of the χ² quadrature
 #else
 constexpr int kChi2Samples = 1000000;
 constexpr int kChi2CosBins = 20, kChi2PhiBins = 40;
 constexpr int kFurnaceSamples = 1000000;
-constexpr double kQuadratureTolerance = 1e-6;
 #endif
 constexpr double kChi2Significance = 0.01;
+/// Relative agreement of a quadrature cell with its halves: expected counts err by ~10⁻⁵, far below √N.
+constexpr double kQuadratureTolerance = 1e-5;
 
 /// SplitMix64: a small deterministic generator of uniform doubles in [0, 1).
 struct Uniform {
@@ -539,7 +539,8 @@ TEST(BsdfFurnace, SmoothInterfaceSplitsByFresnel) {
 
 void expect_albedo(const std::string& what, const Material& m, double cos_o, const Rgb& expected) {
   const Bsdf bsdf(m);
-  const Albedo a = furnace(bsdf, outgoing(cos_o), TransportMode::importance, kFurnaceSamples, 29);
+  // These configurations scatter every particle with weight one; a quarter of the samples suffices.
+  const Albedo a = furnace(bsdf, outgoing(cos_o), TransportMode::importance, kFurnaceSamples / 4, 29);
   std::printf("[furnace] %-34s cos %+.2f  albedo (%.5f %.5f %.5f) ± (%.1e %.1e %.1e)\n", what.c_str(), cos_o, a.mean.x,
               a.mean.y, a.mean.z, a.sigma.x, a.sigma.y, a.sigma.z);
   for (int c = 0; c < 3; ++c)
