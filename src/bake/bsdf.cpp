@@ -21,6 +21,9 @@
 // is symmetric (so the kernel is reciprocal) and gives the diffuse lobes the albedo ρ (1 − s F̂(μo)): what
 // the specular layer does not reflect at normal-ish incidence enters the base (glTF's fresnel_mix with the
 // layer Fresnel taken at the macro normal). With s = 0 the diffuse lobe is exactly Lambertian with albedo ρ.
+// A rough layer reflects the average of F over its visible microfacets, which (F being convex) exceeds
+// F(μo) by up to 0.13 % of 1 − F(μo) for glTF's GGX (measured over roughness 0.1–1, μo 0.1–1); the rough
+// coupling is therefore scaled by κ = 1 − 0.005 s so that the directional albedo never exceeds one.
 // The transmissive interface reflects with s F_d(wo·h) and transmits with (1 − s F̂(wo·h)) ρ, so with
 // white ρ and s = 1 its reflectance and transmittance sum to one exactly for a smooth surface.
 // From inside a volume (wo.z < 0) only the bare dielectric interface remains: reflection F_exact(wo·h, 1/ior)
@@ -46,9 +49,13 @@ namespace bake {
 
 namespace {
 
-double max_channel(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
+double max_channel(const Rgb& c) {
+  return std::max(c.x, std::max(c.y, c.z));
+}
 
-double unit_or(double v, double fallback) { return std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : fallback; }
+double unit_or(double v, double fallback) {
+  return std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : fallback;
+}
 
 Rgb unit_colour(const Rgb& c) {
   Rgb r;
@@ -56,13 +63,21 @@ Rgb unit_colour(const Rgb& c) {
   return r;
 }
 
-bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::dvec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
-Rgb finite_or_zero(const Rgb& c) { return finite(c) ? glm::max(c, Rgb{0.0}) : Rgb{0.0}; }
+Rgb finite_or_zero(const Rgb& c) {
+  return finite(c) ? glm::max(c, Rgb{0.0}) : Rgb{0.0};
+}
 
-glm::dvec3 flip_z(const glm::dvec3& w) { return {w.x, w.y, -w.z}; }
+glm::dvec3 flip_z(const glm::dvec3& w) {
+  return {w.x, w.y, -w.z};
+}
 
-glm::dvec3 reflect_about(const glm::dvec3& wo, const glm::dvec3& n) { return 2.0 * glm::dot(wo, n) * n - wo; }
+glm::dvec3 reflect_about(const glm::dvec3& wo, const glm::dvec3& n) {
+  return 2.0 * glm::dot(wo, n) * n - wo;
+}
 
 /// Refraction of wo (pointing away on the incident side) through the interface with normal n on that side,
 /// eta = ηₜ/ηᵢ: wt = −wo/η + (cos θᵢ/η − cos θₜ) n. False under total internal reflection.
@@ -85,10 +100,10 @@ bool half_vector(const glm::dvec3& a, const glm::dvec3& b, glm::dvec3& h) {
   return h.z > 0.0;
 }
 
-/// Walter et al. 2007 §5.3 refraction geometry for wo.z > 0 (incident side, index 1) and wi.z < 0 (index
-/// η relative): the generalised half vector m = ‖wo + η wi‖ turned to +z (eq. 16), and the squared
-/// denominator (wi·m + wo·m/η)² of the half-vector Jacobian ‖∂ωm/∂ωi‖ = |wi·m| / (wi·m + wo·m/η)² (eq. 17,
-/// divided by η²). False when no front-facing microfacet connects the two directions.
+/// Walter et al. 2007 §5.3 refraction geometry for wo.z > 0 (incident side, index 1) and wi.z < 0
+/// (relative index η): the generalised half vector m = ‖wo + η wi‖ turned to +z (eq. 16), and the squared
+/// denominator (wi·m + wo·m/η)² of the half-vector Jacobian ‖∂ωm/∂ωi‖ = |wi·m| / (wi·m + wo·m/η)²
+/// (eq. 17 divided by η²). False when no front-facing microfacet connects the two directions.
 struct RefractionGeometry {
   glm::dvec3 m{0.0, 0.0, 1.0};
   double wo_dot_m = 0.0, wi_dot_m = 0.0, denom2 = 0.0;
@@ -135,12 +150,11 @@ Bsdf::Bsdf(const Material& material) : material_(material) {
   diffuse_transmission_color_ = unit_colour(material.diffuse_transmission_color);
   base_max_ = max_channel(base_);
   plain_f0_ = fresnel_f0_from_ior(eta_);
-  dielectric_f0_ = glm::min(Rgb{plain_f0_} * unit_colour(glm::max(material.specular_color, Rgb{0.0})), Rgb{1.0});
-  if (!finite(material.specular_color)) dielectric_f0_ = Rgb{plain_f0_};
-  // KHR_materials_specular allows specular_color > 1 (F0 up to 1): re-apply the unclamped colour, capped.
-  for (int c = 0; c < 3; ++c)
-    if (std::isfinite(material.specular_color[c]) && material.specular_color[c] > 1.0)
-      dielectric_f0_[c] = std::min(1.0, plain_f0_ * material.specular_color[c]);
+  // KHR_materials_specular: F0 = min(F0(ior) · specularColor, 1) per channel (the colour may exceed 1).
+  for (int c = 0; c < 3; ++c) {
+    const double colour = material.specular_color[c];
+    dielectric_f0_[c] = std::min(1.0, plain_f0_ * (std::isfinite(colour) ? std::max(0.0, colour) : 1.0));
+  }
 
   // Diffuse coupling normaliser 1 − s F̂_avg with F̂_avg = 2∫₀¹ F̂(μ) μ dμ: closed form for Schlick
   // (2∫(1 − μ)⁵ μ dμ = 1/21), composite Simpson on 256 intervals for the rescaled exact curve.
@@ -159,10 +173,11 @@ Bsdf::Bsdf(const Material& material) : material_(material) {
     fresnel_avg = 2.0 * sum / (3.0 * kIntervals);
   }
   coupling_norm_ = 1.0 - specular_ * std::clamp(fresnel_avg, 0.0, 1.0);
+  coupling_margin_ = smooth_ ? 1.0 : 1.0 - kRoughCouplingMargin * specular_;
 
   const bool reflects = metallic_ > 0.0 || (specular_ > 0.0 && !index_matched_);
-  has_delta_ = (smooth_ && (reflects || transmission_ > 0.0)) ||
-               (index_matched_ && transmission_ > 0.0 && metallic_ < 1.0);
+  has_delta_ =
+      (smooth_ && (reflects || transmission_ > 0.0)) || (index_matched_ && transmission_ > 0.0 && metallic_ < 1.0);
 }
 
 Rgb Bsdf::dielectric_fresnel(double cos_theta) const {
@@ -177,7 +192,9 @@ Rgb Bsdf::dielectric_fresnel(double cos_theta) const {
   return dielectric_f0_ + (Rgb{1.0} - dielectric_f0_) * rise;
 }
 
-double Bsdf::dielectric_fresnel_max(double cos_theta) const { return max_channel(dielectric_fresnel(cos_theta)); }
+double Bsdf::dielectric_fresnel_max(double cos_theta) const {
+  return max_channel(dielectric_fresnel(cos_theta));
+}
 
 Rgb Bsdf::metal_fresnel(double cos_theta) const {
   Rgb f;
@@ -187,9 +204,9 @@ Rgb Bsdf::metal_fresnel(double cos_theta) const {
 
 double Bsdf::diffuse_coupling(double cos_o, double cos_i) const {
   if (!(coupling_norm_ > 1e-12)) return 0.0;
-  const double c = (1.0 - specular_ * dielectric_fresnel_max(cos_o)) * (1.0 - specular_ * dielectric_fresnel_max(cos_i)) /
-                   coupling_norm_;
-  return std::max(0.0, c);
+  const double c = (1.0 - specular_ * dielectric_fresnel_max(cos_o)) *
+                   (1.0 - specular_ * dielectric_fresnel_max(cos_i)) / coupling_norm_;
+  return std::max(0.0, c * coupling_margin_);
 }
 
 double Bsdf::interface_reflect_probability(double cos_theta) const {
@@ -321,8 +338,8 @@ double Bsdf::pdf(const glm::dvec3& wo, const glm::dvec3& wi) const {
         if (half_vector(wo, wr, h)) {
           const double c = glm::dot(wo, h);
           if (c > 0.0)
-            density += p.interface * (1.0 - interface_reflect_probability(c)) * ggx_.visible_normal_density(wo, h) /
-                       (4.0 * c);
+            density +=
+                p.interface * (1.0 - interface_reflect_probability(c)) * ggx_.visible_normal_density(wo, h) / (4.0 * c);
         }
       } else {
         RefractionGeometry g;
@@ -411,8 +428,7 @@ std::optional<BsdfSample> Bsdf::sample(const glm::dvec3& wo, double u_lobe, cons
         return delta_sample(wo, mirror, p.specular + p.interface * reflect_p, coefficient);
       }
       const double probability = p.interface * (1.0 - reflect_p);
-      const Rgb importance =
-          dielectric * transmission_ * base_ * (1.0 - specular_ * dielectric_fresnel_max(wo.z));
+      const Rgb importance = dielectric * transmission_ * base_ * (1.0 - specular_ * dielectric_fresnel_max(wo.z));
       if (!material_.volume || index_matched_) return delta_sample(wo, -wo, probability, importance);
       glm::dvec3 wi;
       if (!refract_about(wo, glm::dvec3(0.0, 0.0, 1.0), eta_, wi)) return std::nullopt;

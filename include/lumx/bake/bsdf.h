@@ -35,10 +35,10 @@ namespace bake {
 enum class TransportMode { radiance, importance };
 
 struct BsdfSample {
-  glm::dvec3 wi{0.0};   ///< sampled direction, local frame, away from the surface
-  Rgb weight{0.0};      ///< f(wo, wi) |cos θi| / pdf, per channel (the throughput multiplier)
-  double pdf = 0.0;     ///< solid-angle density of wi (for a delta lobe: the probability of picking it)
-  bool delta = false;   ///< wi came from a specular (Dirac) lobe; eval() and pdf() are zero for it
+  glm::dvec3 wi{0.0};        ///< sampled direction, local frame, away from the surface
+  Rgb weight{0.0};           ///< f(wo, wi) |cos θi| / pdf, per channel (the throughput multiplier)
+  double pdf = 0.0;          ///< solid-angle density of wi (for a delta lobe: the probability of picking it)
+  bool delta = false;        ///< wi came from a specular (Dirac) lobe; eval() and pdf() are zero for it
   bool transmitted = false;  ///< wi is on the other side of the surface from wo
 };
 
@@ -51,8 +51,7 @@ class Bsdf {
   /// The density sample() draws wi with, 1/sr, excluding delta lobes (the mixture over lobes).
   double pdf(const glm::dvec3& wo, const glm::dvec3& wi) const;
   /// Draws wi from wo; u_lobe picks the lobe, u the direction. nullopt when nothing scatters.
-  std::optional<BsdfSample> sample(const glm::dvec3& wo, double u_lobe, const glm::dvec2& u,
-                                   TransportMode mode) const;
+  std::optional<BsdfSample> sample(const glm::dvec3& wo, double u_lobe, const glm::dvec2& u, TransportMode mode) const;
 
   bool has_delta_lobe() const { return has_delta_; }
   const Material& material() const { return material_; }
@@ -64,9 +63,9 @@ class Bsdf {
 
  private:
   struct LobeProbabilities {
-    double specular = 0.0;      ///< GGX / mirror reflection (metal and the opaque dielectric's coat)
-    double interface = 0.0;     ///< the transmissive dielectric interface (reflects or transmits)
-    double diffuse = 0.0;       ///< Lambertian reflection
+    double specular = 0.0;              ///< GGX / mirror reflection (metal and the opaque dielectric's coat)
+    double interface = 0.0;             ///< the transmissive dielectric interface (reflects or transmits)
+    double diffuse = 0.0;               ///< Lambertian reflection
     double diffuse_transmission = 0.0;  ///< Lambertian transmission to the other side
   };
 
@@ -90,13 +89,17 @@ class Bsdf {
   GgxDistribution ggx_{1.0};
   bool smooth_ = false;
   bool index_matched_ = false;
-  double eta_ = 1.5;          ///< sanitised ior (η of the solid against the outside)
+  double eta_ = 1.5;  ///< sanitised ior (η of the solid against the outside)
   double metallic_ = 0.0, transmission_ = 0.0, specular_ = 1.0, diffuse_transmission_ = 0.0;
   Rgb base_{1.0}, diffuse_transmission_color_{1.0};
-  Rgb dielectric_f0_{0.04};   ///< min(F0(ior) · specular_color, 1) per channel
-  double plain_f0_ = 0.04;    ///< F0(ior), the bare interface's normal reflectance
-  double base_max_ = 1.0;     ///< max channel of the base colour (transmission tint)
-  double coupling_norm_ = 1.0;  ///< 1 − specular · 2∫ F̂(μ) μ dμ (diffuse coupling normaliser)
+  Rgb dielectric_f0_{0.04};       ///< min(F0(ior) · specular_color, 1) per channel
+  double plain_f0_ = 0.04;        ///< F0(ior), the bare interface's normal reflectance
+  double base_max_ = 1.0;         ///< max channel of the base colour (transmission tint)
+  double coupling_norm_ = 1.0;    ///< 1 − specular · 2∫ F̂(μ) μ dμ (diffuse coupling normaliser)
+  double coupling_margin_ = 1.0;  ///< κ: 1 − kRoughCouplingMargin · specular for rough layers, else 1
+  /// Share of the diffuse coupling a rough specular layer withholds (covers the visible-microfacet Fresnel
+  /// average exceeding the macro-normal Fresnel; see src/bake/bsdf.cpp).
+  static constexpr double kRoughCouplingMargin = 0.005;
 };
 
 }  // namespace bake
