@@ -555,6 +555,37 @@ TEST(GltfBadInput, EachProblemIsALocatedError) {
             "/nodes/0/extensions/EXT_lights_ies/light");
 }
 
+TEST(GltfBadInput, SizeLimitsComeFromTheOptions) {
+  const auto dir = lumx_gltf_test::scratch_dir("limits");
+  GltfBuilder b = emissive_quad();
+  b.doc["scenes"][0]["nodes"].push_back(b.add_node({{"mesh", 0}, {"translation", {0, 0, 1}}}));
+  b.write_glb(dir / "two.glb");
+  auto error_with = [&](const std::function<void(bake::GltfReadOptions&)>& limit) {
+    bake::GltfReadOptions o;
+    limit(o);
+    try {
+      bake::read_gltf_luminaire((dir / "two.glb").string(), o);
+    } catch (const lumx::Error& e) {
+      return e.diagnostic();
+    }
+    ADD_FAILURE() << "read within the limits";
+    return lumx::Diagnostic{};
+  };
+  auto d = error_with([](auto& o) { o.max_file_bytes = 100; });
+  EXPECT_EQ(d.field, "file size");
+  EXPECT_EQ(d.byte_offset, 0);
+  EXPECT_EQ(error_with([](auto& o) { o.max_buffer_bytes = 10; }).field, "/buffers/0/byteLength");
+  EXPECT_EQ(error_with([](auto& o) { o.max_vertices = 3; }).field, "/accessors/0/count");
+  EXPECT_EQ(error_with([](auto& o) { o.max_triangles = 1; }).field, "/accessors/1/count");
+  // Each placement counts: two quads of 2 triangles (4 vertices) each.
+  EXPECT_EQ(error_with([](auto& o) { o.max_triangles = 3; }).field, "/nodes/1");
+  EXPECT_EQ(error_with([](auto& o) { o.max_vertices = 7; }).field, "/nodes/1");
+  bake::GltfReadOptions exact;
+  exact.max_triangles = 4;
+  exact.max_vertices = 8;
+  EXPECT_EQ(bake::read_gltf_luminaire((dir / "two.glb").string(), exact).triangle_count(), 4u);
+}
+
 TEST(GltfBadInput, MalformedJsonAndGlbContainersAreLocatedByByteOffset) {
   const auto dir = lumx_gltf_test::scratch_dir("container");
   lumx_gltf_test::write_text(dir / "syntax.gltf", "{\"asset\": {\"version\": \"2.0\"},, }");
