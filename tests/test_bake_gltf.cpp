@@ -535,6 +535,9 @@ TEST(GltfBadInput, EachProblemIsALocatedError) {
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["nodes"][0]["mesh"] = 4; }), "/nodes/0/mesh");
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["scenes"][0]["nodes"] = {3}; }), "/scenes/0/nodes/0");
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["scene"] = 2; }), "/scene");
+  EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["scenes"][0]["nodes"] = {0, 0}; }), "/scenes/0/nodes/1");
+  EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["scenes"][0]["nodes"] = {0, b.add_node({{"children", {0}}})}; }),
+            "/nodes/1/children/0");
   // Asset and lights.
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["asset"]["version"] = "1.0"; }), "/asset/version");
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc.erase("asset"); }), "/asset");
@@ -580,6 +583,7 @@ TEST(GltfBadInput, SizeLimitsComeFromTheOptions) {
   // Each placement counts: two quads of 2 triangles (4 vertices) each.
   EXPECT_EQ(error_with([](auto& o) { o.max_triangles = 3; }).field, "/nodes/1");
   EXPECT_EQ(error_with([](auto& o) { o.max_vertices = 7; }).field, "/nodes/1");
+  EXPECT_EQ(error_with([](auto& o) { o.max_parts = 1; }).field, "/nodes/1/mesh");
   bake::GltfReadOptions exact;
   exact.max_triangles = 4;
   exact.max_vertices = 8;
