@@ -598,6 +598,10 @@ TEST(GltfBadInput, MalformedJsonAndGlbContainersAreLocatedByByteOffset) {
   EXPECT_EQ(d.byte_offset, 29);  // the second comma
   lumx_gltf_test::write_text(dir / "truncated.gltf", "{\"asset\": {\"version\": \"2.");
   EXPECT_EQ(read_error(dir / "truncated.gltf").field, "JSON");
+  lumx_gltf_test::write_text(dir / "bytes.gltf", "{\"asset\": \x89\xFF}");
+  d = read_error(dir / "bytes.gltf");
+  EXPECT_EQ(d.byte_offset, 10);
+  EXPECT_NE(d.message.find("\\x89"), std::string::npos) << d.message;  // raw bytes shown escaped
   lumx_gltf_test::write_text(dir / "array.gltf", "[1, 2]");
   EXPECT_EQ(read_error(dir / "array.gltf").field, "");
   lumx_gltf_test::write_text(dir / "deep.gltf", std::string(200000, '[') + std::string(200000, ']'));
