@@ -19,6 +19,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <random>
 
 namespace fs = std::filesystem;
 namespace bake = lumx::bake;
@@ -534,6 +535,9 @@ TEST(GltfBadInput, EachProblemIsALocatedError) {
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["nodes"][0]["mesh"] = 4; }), "/nodes/0/mesh");
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["scenes"][0]["nodes"] = {3}; }), "/scenes/0/nodes/0");
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["scene"] = 2; }), "/scene");
+  EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["scenes"][0]["nodes"] = {0, 0}; }), "/scenes/0/nodes/1");
+  EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["scenes"][0]["nodes"] = {0, b.add_node({{"children", {0}}})}; }),
+            "/nodes/1/children/0");
   // Asset and lights.
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc["asset"]["version"] = "1.0"; }), "/asset/version");
   EXPECT_EQ(broken([](GltfBuilder& b) { b.doc.erase("asset"); }), "/asset");
@@ -554,6 +558,38 @@ TEST(GltfBadInput, EachProblemIsALocatedError) {
             "/nodes/0/extensions/EXT_lights_ies/light");
 }
 
+TEST(GltfBadInput, SizeLimitsComeFromTheOptions) {
+  const auto dir = lumx_gltf_test::scratch_dir("limits");
+  GltfBuilder b = emissive_quad();
+  b.doc["scenes"][0]["nodes"].push_back(b.add_node({{"mesh", 0}, {"translation", {0, 0, 1}}}));
+  b.write_glb(dir / "two.glb");
+  auto error_with = [&](const std::function<void(bake::GltfReadOptions&)>& limit) {
+    bake::GltfReadOptions o;
+    limit(o);
+    try {
+      bake::read_gltf_luminaire((dir / "two.glb").string(), o);
+    } catch (const lumx::Error& e) {
+      return e.diagnostic();
+    }
+    ADD_FAILURE() << "read within the limits";
+    return lumx::Diagnostic{};
+  };
+  auto d = error_with([](auto& o) { o.max_file_bytes = 100; });
+  EXPECT_EQ(d.field, "file size");
+  EXPECT_EQ(d.byte_offset, 0);
+  EXPECT_EQ(error_with([](auto& o) { o.max_buffer_bytes = 10; }).field, "/buffers/0/byteLength");
+  EXPECT_EQ(error_with([](auto& o) { o.max_vertices = 3; }).field, "/accessors/0/count");
+  EXPECT_EQ(error_with([](auto& o) { o.max_triangles = 1; }).field, "/accessors/1/count");
+  // Each placement counts: two quads of 2 triangles (4 vertices) each.
+  EXPECT_EQ(error_with([](auto& o) { o.max_triangles = 3; }).field, "/nodes/1");
+  EXPECT_EQ(error_with([](auto& o) { o.max_vertices = 7; }).field, "/nodes/1");
+  EXPECT_EQ(error_with([](auto& o) { o.max_parts = 1; }).field, "/nodes/1/mesh");
+  bake::GltfReadOptions exact;
+  exact.max_triangles = 4;
+  exact.max_vertices = 8;
+  EXPECT_EQ(bake::read_gltf_luminaire((dir / "two.glb").string(), exact).triangle_count(), 4u);
+}
+
 TEST(GltfBadInput, MalformedJsonAndGlbContainersAreLocatedByByteOffset) {
   const auto dir = lumx_gltf_test::scratch_dir("container");
   lumx_gltf_test::write_text(dir / "syntax.gltf", "{\"asset\": {\"version\": \"2.0\"},, }");
@@ -562,8 +598,14 @@ TEST(GltfBadInput, MalformedJsonAndGlbContainersAreLocatedByByteOffset) {
   EXPECT_EQ(d.byte_offset, 29);  // the second comma
   lumx_gltf_test::write_text(dir / "truncated.gltf", "{\"asset\": {\"version\": \"2.");
   EXPECT_EQ(read_error(dir / "truncated.gltf").field, "JSON");
+  lumx_gltf_test::write_text(dir / "bytes.gltf", "{\"asset\": \x89\xFF}");
+  d = read_error(dir / "bytes.gltf");
+  EXPECT_EQ(d.byte_offset, 10);
+  EXPECT_NE(d.message.find("\\x89"), std::string::npos) << d.message;  // raw bytes shown escaped
   lumx_gltf_test::write_text(dir / "array.gltf", "[1, 2]");
   EXPECT_EQ(read_error(dir / "array.gltf").field, "");
+  lumx_gltf_test::write_text(dir / "deep.gltf", std::string(200000, '[') + std::string(200000, ']'));
+  EXPECT_EQ(read_error(dir / "deep.gltf").field, "");  // parsed and freed without recursion
 
   const std::vector<std::uint8_t> good = emissive_quad().glb_bytes();
   auto variant = [&](const char* name, const std::function<void(std::vector<std::uint8_t>&)>& edit) {
@@ -614,6 +656,57 @@ TEST(GltfBadInput, CorruptDracoPayloadsAreLocatedErrors) {
   b.doc["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["bufferView"] = 40;
   b.write_glb(dir / "view.glb");
   EXPECT_EQ(read_error(dir / "view.glb").field, "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression/bufferView");
+}
+
+namespace {
+/// Reads `count` random corruptions of `good` (bytes overwritten at random positions from `first` on, or the
+/// file cut short): each must read or throw lumx::Error, nothing else. Returns how many were errors.
+int corrupt_and_read(const fs::path& dir, const std::vector<std::uint8_t>& good, std::size_t first, int count,
+                     unsigned seed) {
+  std::mt19937 rng(seed);
+  int errors = 0;
+  for (int i = 0; i < count; ++i) {
+    std::vector<std::uint8_t> bytes = good;
+    if (rng() % 8 == 0) {
+      bytes.resize(rng() % bytes.size());
+    } else {
+      const int flips = 1 + static_cast<int>(rng() % 4);
+      for (int k = 0; k < flips; ++k) {
+        const std::size_t at = first + rng() % (bytes.size() - first);
+        bytes[at] = rng() % 2 ? static_cast<std::uint8_t>(rng()) : static_cast<std::uint8_t>("0123456789\"\\{}[],:"[rng() % 19]);
+      }
+    }
+    const fs::path p = dir / ("corrupt" + std::to_string(i) + ".glb");
+    lumx_gltf_test::write_bytes(p, bytes);
+    try {
+      bake::read_gltf_luminaire(p.string());
+    } catch (const lumx::Error&) {
+      ++errors;
+    }
+    fs::remove(p);
+  }
+  return errors;
+}
+}  // namespace
+
+TEST(GltfBadInput, RandomCorruptionsAreErrorsNeverCrashes) {
+  const auto dir = lumx_gltf_test::scratch_dir("corrupt");
+  GltfBuilder b = emissive_quad();
+  b.use_extension("KHR_lights_punctual");
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "spot"}, {"intensity", 3}, {"spot", {{"outerConeAngle", 0.5}}}}};
+  b.doc["nodes"][0]["children"] = {b.add_node({{"mesh", b.add_mesh(lumx_gltf_test::unit_cube(), 0)}, {"scale", {2, 2, 2}},
+                                              {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})};
+  const int errors = corrupt_and_read(dir.path, b.glb_bytes(), 0, 1500, 20261126);
+  EXPECT_GT(errors, 500);
+  // Corrupt Draco bitstreams (bytes after the JSON chunk of the real file).
+  const fs::path draco = lumx_test::shared_dir().empty()
+                             ? fs::path()
+                             : lumx_test::shared_dir() / "data" / "luminaires" / "zhu2021-flower" / "flower_draco.glb";
+  if (draco.empty() || !fs::exists(draco)) return;
+  const std::string text = lumx_test::read_text(draco);
+  const std::vector<std::uint8_t> bytes(text.begin(), text.end());
+  const std::size_t json_end = 20 + (bytes[12] | bytes[13] << 8 | bytes[14] << 16 | std::size_t(bytes[15]) << 24);
+  corrupt_and_read(dir.path, bytes, json_end, 150, 7);
 }
 
 // ---- the flower pendant (../shared) -----------------------------------------------------------------------------

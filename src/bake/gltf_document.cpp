@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -309,6 +310,17 @@ Document::Document(const std::string& path, const GltfReadOptions& options)
     std::string msg = e.what();
     const auto colon = msg.find("] ");
     if (colon != std::string::npos) msg = msg.substr(colon + 2);
+    std::string printable;  // the parser quotes what it read last, which may be any bytes
+    for (unsigned char c : msg) {
+      if (c >= 0x20 && c < 0x7F) {
+        printable += static_cast<char>(c);
+      } else {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "\\x%02X", c);
+        printable += hex;
+      }
+    }
+    msg = printable;
     throw_at_offset(path, json_offset + std::int64_t(e.byte > 0 ? e.byte - 1 : 0), "JSON", msg);
   }
   if (!json_.is_object()) throw_at_field(path, "", "the glTF JSON must be an object");

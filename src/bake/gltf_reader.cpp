@@ -381,7 +381,13 @@ class SceneBuilder {
       sj.require_object();
       if (sj.has("nodes")) {
         const JsonRef list = sj.member("nodes");
-        for (std::size_t i = 0; i < list.array_size(); ++i) roots.push_back(child_index(list, i, nodes));
+        std::vector<bool> listed(nodes, false);
+        for (std::size_t i = 0; i < list.array_size(); ++i) {
+          const std::uint32_t n = child_index(list, i, nodes);
+          if (listed[n]) list.element(i).fail("node " + std::to_string(n) + " is listed twice in the scene");
+          listed[n] = true;
+          roots.push_back(n);
+        }
       }
       return roots;
     }
@@ -413,7 +419,6 @@ class SceneBuilder {
     std::vector<Placement> stack;
     for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back(Placement{*it, glm::dmat4(1.0)});
     for (std::uint32_t r : roots) {
-      if (reached_from[r] != -2) doc_.fail("/scenes", "node " + std::to_string(r) + " is listed twice as a root");
       reached_from[r] = -1;
     }
     std::uint64_t visits = 0;
@@ -514,17 +519,21 @@ class SceneBuilder {
 
   void decode_placed_primitives(const std::vector<Placement>& placements) {
     const std::size_t meshes = doc_.count("meshes");
+    std::set<std::uint32_t> decoded;
+    std::uint64_t parts = 0;
     for (const Placement& pl : placements) {
       const JsonRef node = doc_.root().member("nodes").element(pl.node);
       if (!node.has("mesh")) continue;
       const std::uint32_t m = node.index("mesh", meshes, "meshes");
       const JsonRef prims = doc_.root().member("meshes").element(m).member("primitives");
+      parts += prims.array_size();
+      if (parts > options_.max_parts)
+        node.member("mesh").fail("the scene would have more than " + std::to_string(options_.max_parts) + " parts");
+      if (!decoded.insert(m).second) continue;
       for (std::uint32_t k = 0; k < prims.array_size(); ++k) {
-        const auto key = std::make_pair(m, k);
-        if (primitives_.count(key)) continue;
         LocalPrimitive lp = decode_primitive(m, k);
         any_normals_ = any_normals_ || !lp.normals.empty();
-        primitives_.emplace(key, std::move(lp));
+        primitives_.emplace(std::make_pair(m, k), std::move(lp));
       }
     }
   }

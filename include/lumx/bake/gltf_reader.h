@@ -67,6 +67,7 @@ struct GltfReadOptions {
   std::uint64_t max_triangles = 50'000'000;  ///< over the whole scene, after instancing by nodes
   std::uint64_t max_vertices = 100'000'000;  ///< over the whole scene, after instancing by nodes
   std::uint64_t max_nodes_placed = 1'000'000;  ///< node visits while walking the scene
+  std::uint64_t max_parts = 1'000'000;         ///< primitives placed by nodes, over the whole scene
 };
 
 /// Reads a luminaire. Throws lumx::Error with a located diagnostic (file, byte offset or JSON pointer).
