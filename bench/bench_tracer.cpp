@@ -3,7 +3,9 @@
 // Particle tracing throughput against the ray-casting ceiling on the same scene, in the same run:
 //   BM_TraceParticles/<scene>/<threads>   particles/s and path segments/s of lumx::bake::Tracer
 //   BM_RawIntersect/<scene>/<threads>     rtcIntersect1 rays/s: incoherent rays from random points in the
-//                                          luminaire's box in uniform directions (the ceiling)
+//                                          luminaire's box in uniform directions (a generic ceiling)
+//   BM_ReplayRays/<scene>/<threads>       rtcIntersect1 rays/s on exactly the rays a trace casts (recorded
+//                                          segments and exits, replayed in order): the ceiling of that trace
 // Scenes: 0 = the procedural prismatic pendant (277 824 triangles), 1 = the flower lamp from ../shared
 // (7 898 triangles; skipped when absent). Compare segments/s with rays/s of the same scene and thread count.
 #include "procedural_luminaire.h"
@@ -70,12 +72,54 @@ void BM_TraceParticles(benchmark::State& state) {
   state.counters["segments_per_particle"] = double(segments) / double(std::max<std::uint64_t>(1, particles));
 }
 
+/// The rays a trace of `particles` particles casts: every internal segment and every exit ray.
+std::vector<RTCRay> traced_rays(const lumx::bake::LuminaireScene& scene, std::uint64_t particles) {
+  struct RecordingSink : lumx::bake::ParticleSink {
+    std::vector<RTCRay> rays;
+    void add(const glm::vec3& o, const glm::vec3& d) {
+      RTCRay r;
+      r.org_x = o.x, r.org_y = o.y, r.org_z = o.z;
+      r.dir_x = d.x, r.dir_y = d.y, r.dir_z = d.z;
+      r.tnear = 0.0f, r.tfar = std::numeric_limits<float>::infinity(), r.mask = 0xFFFFFFFFu, r.time = 0.0f, r.flags = 0;
+      rays.push_back(r);
+    }
+    void consume(const lumx::bake::ParticleChunk& c) override {
+      for (const auto& s : c.segments) add(s.origin, s.direction);
+      for (const auto& x : c.exits) add(x.position, x.direction);
+    }
+  } sink;
+  const lumx::bake::Tracer tracer(scene);
+  lumx::bake::TraceOptions o;
+  o.particles = particles;
+  o.record_segments = true;
+  tracer.trace(o, sink);
+  return std::move(sink.rays);
+}
+
+void cast_rays(benchmark::State& state, const lumx::bake::LuminaireScene* scene, const std::vector<RTCRay>* given);
+
+void BM_ReplayRays(benchmark::State& state) {
+  const auto* scene = scene_for(int(state.range(0)));
+  if (!scene) {
+    state.SkipWithError("the flower lamp is not in ../shared");
+    return;
+  }
+  static std::map<int, std::vector<RTCRay>> recorded;
+  auto& rays = recorded[int(state.range(0))];
+  if (rays.empty()) rays = traced_rays(*scene, 60000);
+  cast_rays(state, scene, &rays);
+}
+
 void BM_RawIntersect(benchmark::State& state) {
   const auto* scene = scene_for(int(state.range(0)));
   if (!scene) {
     state.SkipWithError("the flower lamp is not in ../shared");
     return;
   }
+  cast_rays(state, scene, nullptr);
+}
+
+void cast_rays(benchmark::State& state, const lumx::bake::LuminaireScene* scene, const std::vector<RTCRay>* given) {
   RTCDevice device = rtcNewDevice(nullptr);
   RTCScene rtc = rtcNewScene(device);
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -96,10 +140,12 @@ void BM_RawIntersect(benchmark::State& state) {
   rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
   rtcCommitScene(rtc);
 
-  const std::size_t n = 1 << 18;
-  std::vector<RTCRay> rays(n);
+  std::vector<RTCRay> rays(given ? given->size() : std::size_t(1) << 18);
+  const std::size_t n = rays.size();
+  if (given) std::copy(given->begin(), given->end(), rays.begin());
   lumx::bake::Pcg32 rng(1, 2);
   for (auto& r : rays) {
+    if (given) break;
     const double z = 1 - 2 * rng.next_double(), phi = 2 * lumx::kPi * rng.next_double(), s = std::sqrt(1 - z * z);
     r.org_x = lo.x + float(rng.next_double()) * (hi.x - lo.x);
     r.org_y = lo.y + float(rng.next_double()) * (hi.y - lo.y);
@@ -139,5 +185,6 @@ void BM_RawIntersect(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_TraceParticles)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"scene", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ReplayRays)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"scene", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_RawIntersect)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"scene", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_MAIN();
