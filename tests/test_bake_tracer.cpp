@@ -15,6 +15,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -132,6 +133,7 @@ TEST(BakeTracer, IntegratingSphereExitFlux) {
   Estimate exit;
   for (const ExitParticle& x : t.sink.exits) exit.add(luminance(glm::dvec3(x.flux_lm)));
   const double se = exit.standard_error(kParticles);
+  std::printf("integrating sphere: exit flux %.5f lm, exact %.5f lm, standard error %.5f lm\n", exit.sum, expected, se);
   // The 128-gon port and the polygonal wall differ from the sphere by < 5·10⁻⁴ relative in area.
   EXPECT_NEAR(exit.sum, expected, 4 * se + 5e-4 * expected) << "SE " << se;
   // Interpolated normals make a few grazing bounces point into the wall: they are rejected (counted), a
@@ -166,6 +168,7 @@ TEST(BakeTracer, GlassBallWithAbsorption) {
     bins[std::min(9, int(5 * (double(x.direction.z) + 1)))] += y;  // equal solid angle per z bin
   }
   const double se = exit.standard_error(kParticles);
+  std::printf("glass ball: exit flux %.5f lm, exact %.5f lm, standard error %.5f lm\n", exit.sum, expected, se);
   // Facets tilt the normal by < 0.3° from radial: Fresnel at 0.3° differs from R₀ by < 10⁻⁶.
   EXPECT_NEAR(exit.sum, expected, 4 * se + 1e-4 * expected) << "SE " << se;
   EXPECT_EQ(t.counters.leaked, 0u);
@@ -195,6 +198,8 @@ TEST(BakeTracer, ParaboloidMirrorCollimates) {
     worst_reflected_angle = std::max(worst_reflected_angle, std::acos(std::min(1.0, double(x.direction.z))));
   }
   const double n = double(kParticles), se = std::sqrt(n * fraction * (1 - fraction));
+  std::printf("paraboloid: %llu of %.0f particles reflected, exact %.1f (binomial SE %.1f); widest reflected %.3f deg\n",
+              (unsigned long long)reflected, n, n * fraction, se, worst_reflected_angle * 180 / lumx::kPi);
   // The 256-gon rim differs from the circle by < 10⁻⁴ in solid angle.
   EXPECT_NEAR(double(reflected), n * fraction, 4 * se + 1e-4 * n);
   EXPECT_EQ(t.counters.exited, kParticles);
@@ -250,6 +255,8 @@ TEST(BakeTracer, BoxWithHolesExactVisibility) {
   }
   EXPECT_EQ(outside_holes, 0u);
   const double n = double(kParticles), f = expected_fraction;
+  std::printf("box with holes: %llu of %.0f particles left, exact %.1f (binomial SE %.1f), %llu not through a hole\n",
+              (unsigned long long)t.counters.exited, n, n * f, std::sqrt(n * f * (1 - f)), (unsigned long long)outside_holes);
   EXPECT_NEAR(double(t.counters.exited), n * f, 4 * std::sqrt(n * f * (1 - f)));
   EXPECT_EQ(t.counters.exited + t.counters.absorbed, kParticles);
 }
