@@ -14,6 +14,7 @@
 #include <lumx/io/rayset_io.h>
 #include <lumx/version.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -84,7 +85,11 @@ int run_bake(BakeArgs a) {
 
     // One trace, into a TM-25 file: --rays-out, or a temporary file beside the bundle.
     const bool keep_rays = !a.rays_out.empty();
-    const std::string rays_path = keep_rays ? a.rays_out : a.out + ".rays.tm25ray";
+    // Without --rays-out the exits go to a temporary file beside the bundle ("out/" and "out" alike).
+    std::filesystem::path out_path = std::filesystem::path(a.out).lexically_normal();
+    if (out_path.filename().empty()) out_path = out_path.parent_path();
+    const std::string rays_path =
+        keep_rays ? a.rays_out : (out_path.parent_path() / (out_path.filename().string() + ".rays.tm25ray")).string();
     lumx::RaysetInfo info = traced.info();
     info.text["creator"] = std::string("lumx ") + lumx::kLibraryVersion + " bake";
     lumx::Tm25WriteOptions tm25;
@@ -106,17 +111,18 @@ int run_bake(BakeArgs a) {
     extras.volume = volume.get();
     const std::string name = std::filesystem::path(a.luminaire).filename().string();
     std::string attachment_name = "luminaire";
-    const std::string ext = std::filesystem::path(a.luminaire).extension().string();
+    std::string ext = std::filesystem::path(a.luminaire).extension().string();
+    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     attachment_name += ext == ".gltf" ? ".gltf" : ".glb";
     extras.attachments.push_back(
         {attachment_name, ext == ".gltf" ? "model/gltf+json" : "model/gltf-binary", read_bytes(a.luminaire)});
     auto& p = extras.provenance;
-    p["source"] = a.luminaire;
+    if (!keep_rays) p["source"] = a.luminaire;  // else the kept rays file: lumx eval recognises its own rays by it
     p["generator"] = std::string("lumx ") + lumx::kLibraryVersion + " bake";
     p["luminaire"] = name + " (attachments/" + attachment_name + ", byte for byte; its SHA-256 is in the manifest)";
     p["seed"] = std::to_string(a.seed);
     p["particles"] = std::to_string(c.emitted);
-    p["trace_seconds"] = std::to_string(trace_seconds);
+    p["trace_seconds"] = std::to_string(trace_seconds);  // reading, scene set-up, tracing and the TM-25 file
     p["trace_counters"] = "exited " + std::to_string(c.exited) + ", absorbed " + std::to_string(c.absorbed) +
                           ", roulette " + std::to_string(c.roulette_killed) + ", depth-capped " +
                           std::to_string(c.depth_capped) + ", leaked " + std::to_string(c.leaked) + ", segments " +
@@ -124,19 +130,18 @@ int run_bake(BakeArgs a) {
     p["emitted_lm"] = std::to_string(c.emitted_lm);
     p["exited_lm"] = std::to_string(c.exited_lm);
 
-    lumx::RaysetReadOptions rro;
-    rro.warnings = [](const lumx::Diagnostic& d) { print_diag(d); };
-    auto rays = lumx::open_rayset(rays_path, rro);
-    a.build.rays = rays_path;
-    a.build.out = a.out;
     int status = 0;
     try {
+      lumx::RaysetReadOptions rro;
+      rro.warnings = [](const lumx::Diagnostic& d) { print_diag(d); };
+      auto rays = lumx::open_rayset(rays_path, rro);
+      a.build.rays = rays_path;
+      a.build.out = a.out;
       status = build_bundle(*rays, a.build, extras);
     } catch (...) {
       if (!keep_rays) std::filesystem::remove(rays_path);
       throw;
     }
-    rays.reset();
     if (!keep_rays) std::filesystem::remove(rays_path);
     return status;
   });

@@ -99,10 +99,11 @@ TEST(BakeExactIrradiance, LambertianDisk) {
   std::vector<double> d;
   const std::vector<double> e = baked_point_errors(
       b.scene(), [&](const glm::dvec3& x, const glm::dvec3& n) { return exact.irradiance(x, n); }, &exit_flux, &d);
-  EXPECT_NEAR(exit_flux, flux, 1e-5 * flux);
+  EXPECT_NEAR(exit_flux, flux, 1e-5 * flux);  // every particle leaves the bare disk: exact up to float sums
   for (std::size_t s = 0; s < d.size(); ++s) {
 #if !defined(__SANITIZE_ADDRESS__)
-    // 1 M particles, 512 APLs: measured 2.4-3.0 % at d ≥ 1 (the rays' own noise at 512 patches is ~1.5 %).
+    // 1 M particles, 512 APLs: measured 3.1-3.2 % at d ≥ 1, as for 1 M rays drawn from the analytic disk
+    // (2.6-3.2 %, docs/apl_sets.md): the maps' noise at 2 000 rays per APL.
     if (d[s] >= 1) {
       EXPECT_LT(e[s], 0.035) << "d = " << d[s];
     }
@@ -128,8 +129,10 @@ TEST(BakeExactIrradiance, PointLightInAGlassBall) {
       &exit_flux, &d);
   for (std::size_t s = 0; s < d.size(); ++s) {
 #if !defined(__SANITIZE_ADDRESS__)
+    // Measured 0.29 % at every d: the exits leave radially, the APLs converge to the centre. This checks the
+    // angular shape (the exit flux itself is checked against its closed form in test_bake_tracer.cpp).
     if (d[s] >= 1) {
-      EXPECT_LT(e[s], 0.03) << "d = " << d[s];
+      EXPECT_LT(e[s], 0.01) << "d = " << d[s];
     }
 #endif
     EXPECT_LT(e[s], 0.25) << "d = " << d[s];

@@ -60,6 +60,10 @@ TEST(CliBake, DiskBundleCarriesPiLAExactly) {
   EXPECT_NEAR(rays->info().header_flux, flux, 1e-5 * flux);
 
   EXPECT_TRUE(lumx::check_bundle((dir / "bundle").string()).empty());
+  // lumx eval knows these are the bundle's own rays (its provenance names them) and grades on held-out ones.
+  const CliRun ev = run_cli("eval " + quoted(dir / "bundle") + " --rays " + quoted(dir / "exits.tm25ray"));
+  ASSERT_EQ(ev.status, 0) << ev.out;
+  EXPECT_NE(ev.out.find("rebuilt from the even rays"), std::string::npos) << ev.out;
   const lumx::BundleReader bundle((dir / "bundle").string());
   const auto& m = bundle.manifest();
   ASSERT_EQ(m.levels.size(), 2u);

@@ -28,13 +28,22 @@ std::size_t pick(const std::vector<double>& cdf, double u) {
   return std::min<std::size_t>(std::size_t(it - cdf.begin()), cdf.size() - 1);
 }
 
-glm::dmat3 rotation_of(const glm::dmat4& m) {
-  glm::dmat3 r(m);
-  for (int c = 0; c < 3; ++c) {
-    const double len = glm::length(r[c]);
-    if (len > 0.0) r[c] /= len;
-  }
-  return r;
+/// The rotation of a node's frame: its linear part orthonormalised (Gram–Schmidt on the columns, keeping the
+/// −z axis lights shine along exact, and handedness). Scale and shear do not change an emitter's
+/// intensities (KHR_lights_punctual, EXT_lights_ies); a singular frame has no direction and is refused.
+bool rotation_of(const glm::dmat4& m, glm::dmat3& r) {
+  glm::dvec3 z(m[2]), x(m[0]);
+  const double lz = glm::length(z);
+  if (!(lz > 0.0) || !std::isfinite(lz)) return false;
+  z /= lz;
+  x -= glm::dot(x, z) * z;
+  const double lx = glm::length(x);
+  if (!(lx > 1e-12 * glm::length(glm::dvec3(m[0]))) || !std::isfinite(lx)) return false;
+  x /= lx;
+  glm::dvec3 y = glm::cross(z, x);
+  if (glm::dot(y, glm::dvec3(m[1])) < 0.0) y = -y;  // keep a mirrored frame mirrored
+  r = glm::dmat3(x, y, z);
+  return true;
 }
 
 glm::dvec3 uniform_sphere(double u1, double u2) {
@@ -69,7 +78,11 @@ EmitterSampler::EmitterSampler(const LuminaireScene& scene) : scene_(scene) {
     s.kind = e.kind;
     s.colour = flux / flux_y;
     s.to_world = e.to_world;
-    s.rotation = rotation_of(e.to_world);
+    if ((e.kind == EmitterKind::spot || e.kind == EmitterKind::ies || e.kind == EmitterKind::rayset) &&
+        !rotation_of(e.to_world, s.rotation))
+      throw_at_field(scene.name, e.source.empty() ? e.name : e.source,
+                     std::string(to_string(e.kind)) + " emitter '" + e.name +
+                         "': its node's transform is singular (a zero scale), so it has no direction");
     switch (e.kind) {
       case EmitterKind::surface: {
         const Part& part = scene.parts.at(e.part);

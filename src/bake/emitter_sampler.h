@@ -7,7 +7,8 @@
 //   surface  uniform by area, cosine-weighted about the geometric normal (πLA exactly), w = colour;
 //   point    uniform on the sphere, w = colour;
 //   spot     uniform in the outer cone, w = colour · falloff(θ) · Ω_cone / Ω_eff (Ω_eff = ∫ falloff dω);
-//   ies      texel ∝ a conservative intensity bound on an equal-area map, uniform in the texel,
+//   ies      texel ∝ the largest intensity at its centre and corners (+10⁻³ of the peak) on an equal-area map,
+//            uniform in the texel,
 //            w = colour · I(ω) / (pdf(ω) Φ_profile);
 //   rayset   a ray ∝ its flux, w = colour.
 #pragma once

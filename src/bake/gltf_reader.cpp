@@ -520,7 +520,7 @@ class SceneBuilder {
   void decode_placed_primitives(const std::vector<Placement>& placements) {
     const std::size_t meshes = doc_.count("meshes");
     std::set<std::uint32_t> decoded;
-    std::uint64_t parts = 0;
+    std::uint64_t parts = 0, decoded_vertices = 0, decoded_triangles = 0;
     for (const Placement& pl : placements) {
       const JsonRef node = doc_.root().member("nodes").element(pl.node);
       if (!node.has("mesh")) continue;
@@ -532,6 +532,16 @@ class SceneBuilder {
       if (!decoded.insert(m).second) continue;
       for (std::uint32_t k = 0; k < prims.array_size(); ++k) {
         LocalPrimitive lp = decode_primitive(m, k);
+        // Decoded data counts against the scene's limits too: primitives may share one large accessor, so
+        // memory would otherwise grow with the number of primitives rather than with the file.
+        decoded_vertices += lp.positions.size();
+        decoded_triangles += lp.indices.size() / 3;
+        if (decoded_vertices > options_.max_vertices)
+          prims.element(k).fail("decoding the meshes would hold more than " + std::to_string(options_.max_vertices) +
+                                " vertices");
+        if (decoded_triangles > options_.max_triangles)
+          prims.element(k).fail("decoding the meshes would hold more than " +
+                                std::to_string(options_.max_triangles) + " triangles");
         any_normals_ = any_normals_ || !lp.normals.empty();
         primitives_.emplace(std::make_pair(m, k), std::move(lp));
       }

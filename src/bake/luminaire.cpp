@@ -74,6 +74,10 @@ Rgb emitter_flux_rgb(const LuminaireScene& scene, const Emitter& e) {
     }
     case EmitterKind::rayset: {
       auto rays = open_rayset(e.rayset_path);
+      // Particles carry photometric flux; rays in W would need a spectrum-weighted efficacy per ray.
+      if (rays->info().quantity != PhotometricQuantity::photometric)
+        throw_at_field(e.rayset_path, "flux quantity",
+                       "the rays carry radiant flux (W); a rayset emitter needs luminous flux (lm) per ray");
       return summarize_rays(*rays).flux_sum * e.color;
     }
   }

@@ -4,6 +4,9 @@
 // used as volumes, and emitters.
 #include <lumx/bake/luminaire_check.h>
 
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -182,6 +185,16 @@ std::vector<Diagnostic> check_luminaire(const LuminaireScene& scene) {
     } catch (const Error& err) {
       out.push_back(finding(scene, Severity::error, where,
                             std::string(to_string(e.kind)) + " emitter '" + e.name + "': " + err.what()));
+    }
+    // Spots, IES profiles and ray files take their directions from the node's frame: it must have one.
+    if (e.kind == EmitterKind::spot || e.kind == EmitterKind::ies || e.kind == EmitterKind::rayset) {
+      const glm::dmat3 linear(e.to_world);
+      const double scale = glm::length(linear[0]) * glm::length(linear[1]) * glm::length(linear[2]);
+      const double det = glm::determinant(linear);
+      if (!std::isfinite(det) || !(std::abs(det) > 1e-12 * scale) || !(scale > 0.0))
+        out.push_back(finding(scene, Severity::error, where,
+                              std::string(to_string(e.kind)) + " emitter '" + e.name +
+                                  "': its node's transform is singular (a zero scale), so it has no direction"));
     }
   }
   return out;

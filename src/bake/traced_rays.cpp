@@ -6,6 +6,7 @@
 #include <lumx/core/diagnostic.h>
 
 #include <algorithm>
+#include <limits>
 
 LUMX_NAMESPACE_BEGIN
 namespace bake {
@@ -38,7 +39,9 @@ TracedRaySource::TracedRaySource(const Tracer& tracer, const TraceOptions& optio
   info_.simulated = true;
   // The exit count is known only after a pass; until then ray_count is the particle count (an upper bound).
   info_.ray_count = options_.particles;
-  info_.header_flux = tracer.total_flux_lm();
+  // The exit flux is known once a pass is complete (then set); the emitted flux is kept as a named value.
+  info_.header_flux = std::numeric_limits<double>::quiet_NaN();
+  info_.values["emitted luminous flux lm"] = tracer.total_flux_lm();
   info_.text["light source"] = tracer.scene().name;
 }
 
@@ -64,6 +67,7 @@ bool TracedRaySource::refill() {
     first_pass_complete_ = true;
     counters_ = pass_counters_;
     info_.ray_count = counters_.exited;
+    info_.header_flux = counters_.exited_lm;
   }
   return false;
 }

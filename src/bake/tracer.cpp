@@ -278,17 +278,26 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
     }
 
     const double t = double(rh.ray.tfar);
+    // Beer–Lambert inside the current solid: transmittance exp(−σ t) over the segment. The segment carries
+    // its mean flux over its length, Φ₀ (1 − e^{−σt}) / (σt), so the radiance volume's track-length deposit
+    // Φ ℓ is right inside absorbing glass too.
+    Rgb mean_flux = beta;
+    if (!media.empty() && t > 0.0) {
+      const Rgb& sigma = absorption[scene.parts[media.top()].material];
+      for (int ch = 0; ch < 3; ++ch) {
+        if (!(sigma[ch] > 0.0)) continue;
+        const double tau = sigma[ch] * t, transmittance = std::exp(-tau);
+        mean_flux[ch] = beta[ch] * (tau > 1e-8 ? -std::expm1(-tau) / tau : 1.0);
+        beta[ch] *= transmittance;
+      }
+    }
     if (o.record_segments) {
       PathSegment seg;
       seg.origin = glm::vec3(origin);
       seg.direction = glm::vec3(direction);
       seg.length_m = float(t);
-      seg.flux_lm = glm::vec3(beta);
+      seg.flux_lm = glm::vec3(mean_flux);
       out.segments.push_back(seg);
-    }
-    if (!media.empty()) {  // Beer–Lambert transmittance exp(−σ t) inside the current solid
-      const Rgb& sigma = absorption[scene.parts[media.top()].material];
-      for (int ch = 0; ch < 3; ++ch) beta[ch] *= sigma[ch] > 0.0 ? std::exp(-sigma[ch] * t) : 1.0;
     }
 
     const std::uint32_t part_index = rh.hit.geomID;
@@ -358,8 +367,8 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
     const double correction = std::abs(wo_local.z) * std::abs(wi_ng) /
                               std::max(std::abs(glm::dot(wo, ng)) * std::abs(s->wi.z), 1e-300);
     beta *= s->weight * correction;
-    if (!(max_component(beta) < std::numeric_limits<double>::infinity())) {
-      c.absorbed += 1;  // a non-finite weight is a BSDF defect; end the path rather than poison the sums
+    if (!(std::isfinite(beta.x) && std::isfinite(beta.y) && std::isfinite(beta.z))) {
+      c.absorbed += 1;  // a non-finite weight is a defect; end the path rather than poison the sums
       return;
     }
 

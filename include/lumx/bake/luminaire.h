@@ -59,7 +59,7 @@ struct Emitter {
   double outer_cone_rad = 0.7853981633974483;  ///< spot: zero outside this half-angle
   Rgb color{1.0};             ///< ies, rayset: colour multiplier per channel
   double multiplier = 1.0;    ///< ies: EXT_lights_ies multiplier applied to the profile's candela
-  std::shared_ptr<const Photometry> photometry;  ///< ies: the profile (candela absolute, tilt applied)
+  std::shared_ptr<const Photometry> photometry;  ///< ies: the profile (absolute candela; TILT data not applied)
   std::string rayset_path;    ///< rayset: resolved path of the ray file
 };
 
