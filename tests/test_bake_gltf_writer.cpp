@@ -8,6 +8,8 @@
 #include <lumx/bake/gltf_writer.h>
 #include <lumx/io/photometry_io.h>
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -57,7 +59,7 @@ LuminaireScene sample_scene() {
 
 TEST(BakeGltfWriter, RoundTripKeepsGeometryMaterialsAndEmitters) {
   const LuminaireScene scene = sample_scene();
-  const fs::path dir = fs::temp_directory_path() / "lumx_gltf_writer";
+  const fs::path dir = lumx_test::unique_temp_path("lumx_gltf_writer");
   fs::create_directories(dir);
   for (const bool binary : {true, false}) {
     lumx::bake::GltfWriteOptions o;
@@ -116,7 +118,7 @@ TEST(BakeGltfWriter, RoundTripKeepsGeometryMaterialsAndEmitters) {
 // agree to ~10⁻⁴ and the triangle count exactly.
 TEST(BakeGltfWriter, DracoRoundTrip) {
   const LuminaireScene scene = sample_scene();
-  const fs::path path = fs::temp_directory_path() / "lumx_gltf_writer_draco.glb";
+  const fs::path path = lumx_test::unique_temp_path("lumx_gltf_writer_draco.glb");
   lumx::bake::GltfWriteOptions o;
   o.draco = true;
   lumx::bake::write_gltf_luminaire(scene, path.string(), o);
@@ -145,7 +147,7 @@ TEST(BakeGltfWriter, RaysetEmittersAreRefusedByName) {
   e.name = "led";
   e.rayset_path = "/nonexistent.tm25ray";
   scene.emitters.push_back(e);
-  const fs::path path = fs::temp_directory_path() / "lumx_gltf_writer_rayset.glb";
+  const fs::path path = lumx_test::unique_temp_path("lumx_gltf_writer_rayset.glb");
   try {
     lumx::bake::write_gltf_luminaire(scene, path.string());
     FAIL() << "expected lumx::Error";

@@ -13,6 +13,8 @@
 #include <lumx/bake/luminaire_check.h>
 #include <lumx/bake/tracer.h>
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -34,7 +36,7 @@ TEST(BakeHardCases, PrimitivesSharingAnAccessorCountAgainstTheLimits) {
   for (int k = 0; k < 50; ++k) prims.push_back({{"attributes", {{"POSITION", pos}}}, {"indices", idx}});
   g.push("meshes", {{"primitives", prims}});
   g.set_scene({g.add_node({{"mesh", 0}})});
-  const fs::path path = fs::temp_directory_path() / "lumx_shared_accessor.glb";
+  const fs::path path = lumx_test::unique_temp_path("lumx_shared_accessor.glb");
   g.write_glb(path);
   lumx::bake::GltfReadOptions o;
   o.max_vertices = 100000;  // 50 primitives × 3 000 vertices = 150 000 decoded
@@ -118,7 +120,7 @@ TEST(BakeHardCases, SegmentsInsideGlassCarryTheirMeanFlux) {
 }
 
 TEST(BakeHardCases, BakeIntoAPathEndingInASeparator) {
-  const fs::path dir = fs::temp_directory_path() / "lumx_bake_slash";
+  const fs::path dir = lumx_test::unique_temp_path("lumx_bake_slash");
   fs::remove_all(dir);
   fs::create_directories(dir);
   lumx_test::SceneBuilder b("disk");

@@ -7,6 +7,8 @@
 #include <lumx/bake/traced_rays.h>
 #include <lumx/io/rayset_io.h>
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -62,7 +64,7 @@ TEST(BakeTracedRays, RewindServesTheSameRaysAndTm25KeepsThem) {
     ASSERT_EQ(first.flux[i], second.flux[i]) << i;
   }
 
-  const auto path = std::filesystem::temp_directory_path() / "lumx_traced_rays.tm25ray";
+  const auto path = lumx_test::unique_temp_path("lumx_traced_rays.tm25ray");
   lumx::write_tm25(path.string(), source.info(), source);
   auto read = lumx::open_rayset(path.string());
   EXPECT_EQ(read->info().ray_count, first.size());

@@ -11,6 +11,8 @@
 #include <lumx/math/sphere_map.h>
 #include <lumx/photometry/intensity_table.h>
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -379,7 +381,7 @@ TEST(BakeTracer, BitIdenticalForAnyThreadCountChunkAndPass) {
 
 // A rayset placed by a node: its rays, transformed, are the particles; its flux is the file's.
 TEST(BakeTracer, RaysetEmitterPlacedByItsNode) {
-  const auto dir = std::filesystem::temp_directory_path() / "lumx_tracer_rayset";
+  const auto dir = lumx_test::unique_temp_path("lumx_tracer_rayset");
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "beam.tm25ray").string();
   lumx::RayChunk chunk;

@@ -22,7 +22,7 @@ using namespace lumx_test;
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("lumx_cli_bake_" + name);
+  const fs::path p = lumx_test::unique_temp_path("lumx_cli_bake_" + name);
   fs::remove_all(p);
   fs::create_directories(p);
   return p;

@@ -8,6 +8,8 @@
 
 #include "cli_test_support.h"
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -106,7 +108,7 @@ TEST(SampleLedStripRays, BadArgumentsAreRefused) {
 // description states (π L A over the meshed emitters: within 1 % of the round figure the sample aims at).
 TEST(SampleLuminaires, FourCheckedLuminairesWithTheirStatedFlux) {
   if (std::string(LUMX_SAMPLE_LUMINAIRES).empty()) GTEST_SKIP() << "samples not built (LUMX_BUILD_SAMPLES=OFF)";
-  const auto dir = std::filesystem::temp_directory_path() / "lumx_sample_luminaires";
+  const auto dir = lumx_test::unique_temp_path("lumx_sample_luminaires");
   std::filesystem::remove_all(dir);
   const lumx_test::CliRun r = lumx_test::run_program(LUMX_SAMPLE_LUMINAIRES, lumx_test::quoted(dir));
   ASSERT_EQ(r.status, 0) << r.out;

@@ -12,7 +12,17 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace lumx_test {
+
+/// A path in the temporary folder unique to this test process (name + pid), so that concurrent test runs
+/// never share scratch files.
+inline std::filesystem::path unique_temp_path(const std::string& name) {
+  const std::filesystem::path n(name);  // the pid goes before the extension: "rays.tm25ray" -> "rays_123.tm25ray"
+  return std::filesystem::temp_directory_path() /
+         (n.stem().string() + "_" + std::to_string(::getpid()) + n.extension().string());
+}
 
 /// tests/data in the source tree: only files lumx made itself (bad-input corpus, synthetic fixtures).
 inline std::filesystem::path data_dir() { return LUMX_TEST_DATA_DIR; }
