@@ -74,7 +74,8 @@ class LuminaireBuilder {
   }
 
   /// A parametric surface p(u, v), u, v ∈ [0, 1], meshed on nu × nv cells; counter-clockwise order is
-  /// p(u0,v0) p(u1,v0) p(u1,v1), so ∂p/∂u × ∂p/∂v is the front. normal(u, v) gives smooth normals (front side).
+  /// p(u0,v0) p(u1,v0) p(u1,v1), so ∂p/∂u × ∂p/∂v is the front. normal(u, v) gives smooth normals (front side);
+  /// an empty `normal` gives flat facets (prisms, ridged sheets).
   void surface(const std::function<glm::dvec3(double, double)>& p,
                const std::function<glm::dvec3(double, double)>& normal, int nu, int nv) {
     for (int i = 0; i < nu; ++i)
@@ -203,6 +204,10 @@ class LuminaireBuilder {
                        glm::dvec2 c) {
     const glm::dvec3 pa = p(a.x, a.y), pb = p(b.x, b.y), pc = p(c.x, c.y);
     if (!(glm::length(glm::cross(pb - pa, pc - pa)) > 1e-14 * (1.0 + glm::length(pa)))) return;  // collapsed
+    if (!normal_at) {
+      flat_triangle(pa, pb, pc);
+      return;
+    }
     triangle(pa, pb, pc, normal_at(a.x, a.y), normal_at(b.x, b.y), normal_at(c.x, c.y));
   }
 
