@@ -264,6 +264,10 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
     c.segments += 1;
 
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      if (!(max_component(beta) > 0.0)) {  // nothing left to carry (an opaque-tinted solid): not an exit
+        c.absorbed += 1;
+        return;
+      }
       ExitParticle x;
       x.position = glm::vec3(position);
       x.direction = glm::vec3(direction);
