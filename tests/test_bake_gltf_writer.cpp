@@ -21,6 +21,13 @@ namespace {
 using namespace lumx_test;
 namespace fs = std::filesystem;
 
+double part_area(const LuminaireScene& scene, std::size_t part) {
+  double area = 0.0;
+  for (std::uint32_t t = 0; t < scene.parts[part].triangle_count; ++t)
+    area += lumx::bake::triangle_area(scene, scene.parts[part].first_triangle + t);
+  return area;
+}
+
 LuminaireScene sample_scene() {
   SceneBuilder b("round trip");
   Material glass = smooth_glass(1.52, 0.7, 0.03);
@@ -70,12 +77,8 @@ TEST(BakeGltfWriter, RoundTripKeepsGeometryMaterialsAndEmitters) {
     ASSERT_EQ(back.triangle_count(), scene.triangle_count());
     ASSERT_EQ(back.parts.size(), scene.parts.size());
     for (std::size_t p = 0; p < scene.parts.size(); ++p) {
-      double a0 = 0.0, a1 = 0.0;
-      for (std::uint32_t t = 0; t < scene.parts[p].triangle_count; ++t) {
-        a0 += lumx::bake::triangle_area(scene, scene.parts[p].first_triangle + t);
-        a1 += lumx::bake::triangle_area(back, back.parts[p].first_triangle + t);
-      }
-      EXPECT_NEAR(a1, a0, 1e-6 * a0) << p;
+      const double a0 = part_area(scene, p);
+      EXPECT_NEAR(part_area(back, p), a0, 1e-6 * a0) << p;
       const Material& m0 = scene.materials[scene.parts[p].material];
       const Material& m1 = back.materials[back.parts[p].material];
       EXPECT_NEAR(m1.roughness, m0.roughness, 1e-12);
@@ -126,12 +129,8 @@ TEST(BakeGltfWriter, DracoRoundTrip) {
   ASSERT_EQ(back.triangle_count(), scene.triangle_count());
   ASSERT_EQ(back.parts.size(), scene.parts.size());
   for (std::size_t p = 0; p < scene.parts.size(); ++p) {
-    double a0 = 0.0, a1 = 0.0;
-    for (std::uint32_t t = 0; t < scene.parts[p].triangle_count; ++t) {
-      a0 += lumx::bake::triangle_area(scene, scene.parts[p].first_triangle + t);
-      a1 += lumx::bake::triangle_area(back, back.parts[p].first_triangle + t);
-    }
-    EXPECT_NEAR(a1, a0, 1e-3 * a0) << p;
+    const double a0 = part_area(scene, p);
+    EXPECT_NEAR(part_area(back, p), a0, 1e-3 * a0) << p;
   }
   double f0 = 0.0, f1 = 0.0;
   for (const auto& e : scene.emitters) f0 += lumx::bake::emitter_flux_lm(scene, e);

@@ -421,9 +421,7 @@ TEST(BakeTracer, LuminaireWithoutFluxIsRefusedByName) {
   }
 }
 
-}  // namespace
 
-namespace {
 
 // A closed white sphere (albedo exactly 1, no port) traps every particle: with roulette switched off, all of
 // them reach the depth cap and are counted there, none leaves.
