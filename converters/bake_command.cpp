@@ -5,6 +5,7 @@
 // prints it.
 #include "bake_command.h"
 
+#include "bake_preview.h"
 #include "cli_support.h"
 #include "eval_commands.h"
 #include "progress.h"
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 namespace lumx_cli {
 
@@ -43,6 +45,11 @@ int run_bake(BakeArgs a) {
         std::snprintf(status + n, sizeof status - std::size_t(n), "  error %.2f %%", 100 * p.error);
       bar.update(p.fraction, p.phase, status);
     };
+    std::unique_ptr<BakePreview> preview;
+    if (!a.preview.empty()) {
+      preview = std::make_unique<BakePreview>(a.preview, a.preview_resolution);
+      o.on_pass = [&](const lumx::bake::BakePass& pass, lumx::RaySource& exits) { preview->on_pass(pass, exits); };
+    }
     const lumx::bake::BakeResult r = lumx::bake::bake_luminaire(a.luminaire, a.out, o);
     bar.done();
 
@@ -68,6 +75,10 @@ int run_bake(BakeArgs a) {
     } else {
       std::printf("passes:    %zu, no target error; stopped by %s\n", r.passes.size(), r.stopped_by.c_str());
     }
+    if (preview)
+      std::printf("preview:   %s (intensity.png, polar.png, per pass intensity_/histogram_/polar_passNN.png, "
+                  "convergence.txt)\n",
+                  a.preview.c_str());
     if (!a.rays_out.empty())
       std::printf("rays:      %s (IES TM-25, the exits as a near-field rayset)\n", a.rays_out.c_str());
     print_build_result(r.bundle, a.build, lumx::PhotometricQuantity::photometric);

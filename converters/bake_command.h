@@ -21,6 +21,8 @@ struct BakeArgs {
   int volume_voxels = 32768;          ///< --volume-voxels (0: no radiance volume)
   std::string rays_out;               ///< --rays-out FILE.tm25ray: the exits as an IES TM-25 rayset
   int max_depth = 256;                ///< --max-depth
+  std::string preview;                ///< --preview DIR: images and a table after every pass
+  int preview_resolution = 64;        ///< --preview-resolution R
   BuildArgs build;                    ///< levels, error tables, far field, threads (as `lumx build`)
 };
 

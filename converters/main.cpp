@@ -182,6 +182,12 @@ const Command kCommands[] = {
            ->check(CLI::Range(1, 100000));
        c.add_option("--rays-out", g_bake.rays_out, "also keep the exits as an IES TM-25 rayset (a virtual near-field "
                                                    "goniophotometer)");
+       c.add_option("--preview", g_bake.preview,
+                    "folder for a preview after every pass: the intensity distribution filtered by pull-push, its "
+                    "histogram, its polar diagram, and a table of errors against passes");
+       c.add_option("--preview-resolution", g_bake.preview_resolution,
+                    "--preview: sphere-map resolution R, a power of two (default 64: 128 x 64 texels)")
+           ->check(CLI::IsMember({1, 2, 4, 8, 16, 32, 64, 128, 256, 512}));
        c.add_option("--levels", g_bake.build.levels, "APLs per level, increasing (default 1 8 64 256 512)");
        c.add_flag("--no-eval", g_bake.build.no_eval, "skip the error evaluation (no error tables, no --target-error)");
        c.add_flag("--progress", g_bake.build.progress, "show the progress bar even when stderr is not a terminal");

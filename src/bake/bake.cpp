@@ -232,6 +232,10 @@ BakeResult bake_luminaire(const std::string& luminaire, const std::string& out, 
     }
     pass.seconds = elapsed();
     result.passes.push_back(pass);
+    if (options.on_pass) {
+      SpoolRaySource exits(spool.path(), spool.exits(), done, info);
+      options.on_pass(pass, exits);
+    }
     if (stopping_rule && pass.error <= options.target_error) {
       result.target_met = true;
       result.stopped_by = "target error";
@@ -251,6 +255,9 @@ BakeResult bake_luminaire(const std::string& luminaire, const std::string& out, 
     } else {
       next = done;  // doubling
     }
+    // A pass that would leave less than half its own size of the budget takes the rest now: a last
+    // sliver would cost a whole grading for almost no particles.
+    if (options.pass_particles == 0 && options.particles - done < next + next / 2) next = options.particles - done;
   }
   result.trace_seconds = elapsed();
 

@@ -80,6 +80,10 @@ struct BakeOptions {
   BundleBuildOptions bundle;
   GltfReadOptions read;                ///< limits and warnings for reading the luminaire
   std::function<void(const BakeProgress&)> progress;
+  /// Called after each pass (and its grading) with the pass and the exits so far as a rayset (lm per ray,
+  /// normalised to the particles traced so far): e.g. a preview of the intensity distribution
+  /// (rays/intensity_preview.h) a luminaire designer watches converge.
+  std::function<void(const BakePass&, RaySource& exits)> on_pass;
 };
 
 struct BakeResult {
