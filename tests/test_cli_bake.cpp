@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
 // `lumx bake`: a luminaire file in, a checked bundle out — the exits' flux exact where every particle leaves,
-// passes, the target error and the preview, the same rays and maps for any thread count, the real flower lamp (plain and Draco), located errors.
+// passes, the target error and the preview, the same rays and maps for any thread count, the real flower
+// lamp (plain and Draco), located errors.
 #include "cli_test_support.h"
 #include "luminaire_test_scenes.h"
 #include "test_support.h"
