@@ -41,8 +41,11 @@ int run_bake(BakeArgs a) {
       char status[160];
       const int n = std::snprintf(status, sizeof status, "pass %d  %.2f M particles  %.0f k/s", p.pass,
                                   double(p.particles) / 1e6, p.particles_per_second / 1e3);
-      if (std::isfinite(p.error) && n > 0 && std::size_t(n) < sizeof status)
-        std::snprintf(status + n, sizeof status - std::size_t(n), "  error %.2f %%", 100 * p.error);
+      int m = n;
+      if (std::isfinite(p.error) && m > 0 && std::size_t(m) < sizeof status)
+        m += std::snprintf(status + m, sizeof status - std::size_t(m), "  error %.2f %%", 100 * p.error);
+      if (std::isfinite(p.eta_seconds) && m > 0 && std::size_t(m) < sizeof status)
+        std::snprintf(status + m, sizeof status - std::size_t(m), "  ETA <= %.0f s", p.eta_seconds);
       bar.update(p.fraction, p.phase, status);
     };
     std::unique_ptr<BakePreview> preview;

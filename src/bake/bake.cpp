@@ -142,6 +142,7 @@ BakeResult bake_luminaire(const std::string& luminaire, const std::string& out, 
 
   // The grading options: the bundle's, with the target distance among the spheres.
   BundleBuildOptions bundle = options.bundle;
+  if (bundle.apl.threads == 0) bundle.apl.threads = unsigned(options.threads);  // 0: every core for both
   bundle.progress = nullptr;
   bundle.evaluated = nullptr;
   const bool stopping_rule = options.target_error > 0;
@@ -201,7 +202,10 @@ BakeResult bake_luminaire(const std::string& luminaire, const std::string& out, 
       progress.particles = done + k;
       const double t = trace_seconds + std::chrono::duration<double>(Clock::now() - pass_start).count();
       progress.particles_per_second = double(progress.particles) / std::max(t, 1e-9);
+      // To the budget's end (an upper bound when a target may stop the bake sooner), or the time limit.
       progress.eta_seconds = double(options.particles - progress.particles) / progress.particles_per_second;
+      if (options.time_limit_seconds > 0)
+        progress.eta_seconds = std::min(progress.eta_seconds, std::max(0.0, options.time_limit_seconds - elapsed()));
       report("tracing", double(k) / double(n));
     };
     to.first_particle = done;

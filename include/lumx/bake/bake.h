@@ -43,7 +43,8 @@ struct BakeProgress {
   std::uint64_t budget = 0;          ///< the particle budget (BakeOptions::particles)
   double particles_per_second = 0;   ///< tracing rate so far
   double error = NAN;                ///< last graded error at the target distance (fraction), NaN before
-  double eta_seconds = NAN;          ///< estimated time to the end of the bake, NaN when unknown
+  double eta_seconds = NAN;          ///< tracing time left to the budget or the time limit (a target may
+                                     ///< stop sooner), NaN before tracing starts
   double elapsed_seconds = 0;
 };
 
