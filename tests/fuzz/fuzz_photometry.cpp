@@ -3,9 +3,7 @@
 // libFuzzer target: any bytes through both readers, validation, the intensity table and both writers.
 // Only lumx::Error may come out of a reader; a table that was read must survive everything after it.
 //
-//   cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DLUMX_BUILD_FUZZERS=ON -DLUMX_BUILD_CLI=OFF \
-//         -DLUMX_BUILD_TESTS=OFF -DLUMX_BUILD_BENCH=OFF && cmake --build build-fuzz
-//   build-fuzz/tests/fuzz/lumx_fuzz_photometry tests/data/bad ../shared/data/photometry/*/ -max_total_time=300
+//   bash scripts/fuzz.sh photometry 300
 #include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/photometry/metrics.h>
