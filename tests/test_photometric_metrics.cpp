@@ -92,8 +92,8 @@ TEST(BugRating, IsotropicThousandLumens) {
   EXPECT_NEAR(r.zones.ul, cap_lm(kIso, 90, 100), tol * r.zones.ul);
   EXPECT_NEAR(r.zones.uh, cap_lm(kIso, 100, 180), tol * r.zones.uh);
   EXPECT_TRUE(r.quadrilateral_symmetric);
-  // By hand: BL 33.5, BM 91.5, BH 81.6 lm -> B0; UL 86.8, UH 586.8 -> U4; FVH 43.4 -> G1.
-  EXPECT_EQ(r.str(), "B0 U4 G1");
+  // By hand: BL 33.5, BM 91.5, BH 81.6 lm -> B0; UL 86.8, UH 413.2 -> U3; FVH 43.4 -> G1.
+  EXPECT_EQ(r.str(), "B0 U3 G1");
 }
 
 TEST(BugRating, LimitsOfAddendumA) {

@@ -10,6 +10,7 @@
 #include <lumx/io/photometry_io.h>
 #include <lumx/math/constants.h>
 #include <lumx/photometry/guth_position_index.h>
+#include <lumx/photometry/intensity_table.h>
 #include <lumx/photometry/luminous_area.h>
 #include <lumx/photometry/room_transfer.h>
 #include <lumx/photometry/ugr.h>
@@ -50,15 +51,15 @@ double max_deviation(const UgrTable& t, const lumx_test::ReferenceTable& ref, co
 }  // namespace
 
 TEST(UgrGuth, TableFollowsGuthsFormula) {
-  // Table 4.1 was tabulated from the closed form; every entry lies within 7 % of it (a transcription
-  // error of one digit would not).
+  // Table 4.1 was tabulated from the closed form, rounded and smoothed: its entries lie within 9.9 % of
+  // it (largest at T/R 2.2, H/R 0.8). A misprinted units digit (p < 10) moves an entry by more than that.
   int checked = 0;
   for (int i = 0; i <= 30; ++i)
     for (int j = 0; j <= 19; ++j) {
       const double p = guth_position_index(i / 10.0, j / 10.0);
       if (std::isnan(p)) continue;
       ++checked;
-      EXPECT_NEAR(p / guth_position_index_formula(i / 10.0, j / 10.0), 1.0, 0.07) << "T/R " << i / 10.0 << " H/R " << j / 10.0;
+      EXPECT_NEAR(p / guth_position_index_formula(i / 10.0, j / 10.0), 1.0, 0.10) << "T/R " << i / 10.0 << " H/R " << j / 10.0;
     }
   EXPECT_GT(checked, 600);
   EXPECT_DOUBLE_EQ(guth_position_index(0, 0), 1.0);  // on the line of sight
@@ -138,13 +139,33 @@ TEST(UgrTable, FluxAddsEightLogOfTheScale) {
 }
 
 TEST(UgrTable, DirectFluxSplitsBetweenFloorAndWalls) {
-  // A narrow downlight sends nearly all of its flux to the floor; the split never loses flux.
-  const Photometry spot = lumx_test::rotational_photometry([](double g) { return g <= 5 ? 1000.0 : 0.0; }, 0.5);
+  // A narrow downlight (cos^40, half-beam 10.6°); the split never loses flux.
+  const Photometry spot = lumx_test::rotational_photometry(
+      [](double g) { return g < 90 ? 1000.0 * std::pow(std::cos(g * kDegToRad), 40) : 0.0; }, 0.5);
   const UgrTable t = ugr_table(spot);
-  for (const auto& tm : t.terms[0]) {
+  for (const auto& tm : t.terms[0])
     EXPECT_NEAR(tm.floor_lm + tm.walls_lm + tm.ceiling_lm, t.luminaire_flux_lm, 1e-3 * t.luminaire_flux_lm);
-    EXPECT_GT(tm.floor_lm, 0.9 * t.luminaire_flux_lm);
-  }
+  // Independently: the floor's flux summed as illuminance E = I cos³g / h² over the floor, averaged over
+  // luminaire positions spread over the ceiling of the 2H x 2H room (midpoint rules, 5 cm and 10 cm).
+  const IntensityTable it(spot);
+  const double h = 2, side = 4;
+  double sum = 0;
+  const int np = 40, nf = 80;
+  for (int a = 0; a < np; ++a)
+    for (int b = 0; b < np; ++b) {
+      const double px = (a + 0.5) * side / np, py = (b + 0.5) * side / np;
+      double flux = 0;
+      for (int i = 0; i < nf; ++i)
+        for (int j = 0; j < nf; ++j) {
+          const double dx = (i + 0.5) * side / nf - px, dy = (j + 0.5) * side / nf - py;
+          const double r2 = dx * dx + dy * dy + h * h, r = std::sqrt(r2);
+          flux += it.intensity({dx, dy, -h}) * (h / r) / r2;
+        }
+      sum += flux * (side / nf) * (side / nf);
+    }
+  const double brute = sum / (np * np);
+  EXPECT_NEAR(t.terms[0][0].floor_lm, brute, 5e-3 * brute);
+  EXPECT_GT(t.terms[0].back().floor_lm, t.terms[0][0].floor_lm);  // a larger room catches more
 }
 
 TEST(UgrTable, PointSourceIsALocatedError) {
