@@ -213,6 +213,22 @@ TEST(ConeDiagram, CosPowerBeamInClosedForm) {
   EXPECT_THROW(cone_diagram(IntensityTable(isotropic()), {1}), std::invalid_argument);  // no beam
 }
 
+TEST(PhotometricMetrics, DarkLuminaireGivesZerosNotNaN) {
+  const Photometry dark = lumx_test::rotational_photometry([](double) { return 0.0; });
+  const ZonalLumenSummary z = zonal_lumen_summary(dark);
+  EXPECT_EQ(z.luminaire_lm, 0.0);
+  for (const Zone& zz : z.summary) EXPECT_EQ(zz.percent_luminaire, 0.0);
+  const CieFluxCode c = cie_flux_code(dark);
+  EXPECT_EQ(c.str(), "0 0 0 0 -");
+  EXPECT_EQ(bug_rating(dark).str(), "B0 U0 G0");
+  const SpacingCriterion s = spacing_criteria(IntensityTable(dark));
+  EXPECT_FALSE(s.c0_c180 || s.c90_c270 || s.diagonal);
+  EXPECT_THROW(cone_diagram(IntensityTable(dark), {1}), std::invalid_argument);
+  EXPECT_EQ(illuminance_grid(IntensityTable(dark)).max_lux, 0.0);
+  const LuminanceTable l = luminance_table(dark);
+  EXPECT_EQ(l.max_cd_m2, 0.0);
+}
+
 TEST(PhotometricMetrics, EverySharedFileGivesFiniteMetrics) {
   const auto files = lumx_test::shared_photometry_files({".ies", ".ldt"});
   if (files.empty()) LUMX_SKIP_WITHOUT_SHARED("data/photometry");

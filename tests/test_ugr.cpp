@@ -177,6 +177,14 @@ TEST(UgrTable, PointSourceIsALocatedError) {
     EXPECT_EQ(e.diagnostic().field, "luminous area");
     EXPECT_EQ(e.diagnostic().file, "synthetic");
   }
+  // A luminaire that emits nothing has no glare to rate: a located error, not a table of NaN.
+  Photometry dark = lumx_test::rotational_photometry([](double) { return 0.0; });
+  try {
+    ugr_table(dark);
+    FAIL() << "zero flux";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.diagnostic().field, "flux");
+  }
   UgrTableOptions bad;
   bad.spacing_to_height = 0;
   EXPECT_THROW(ugr_table(lumx_test::rotational_photometry([](double) { return 100.0; }), bad), std::invalid_argument);
