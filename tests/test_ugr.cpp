@@ -230,3 +230,19 @@ TEST(UgrReference, DialuxAndReluxWhereTheyAgree) {
     EXPECT_LE(r_dev, 0.5) << id;
   }
 }
+
+TEST(UgrReference, SameTableFromTheIesConversion) {
+  // The table depends on the photometry, not on the file format it came in: sample_11 written as IES
+  // (its flat luminous area becomes the IES opening) and read back rates the same within 0.05.
+  const auto dir = lumx_test::shared_photometry(kUgrFolder);
+  if (dir.empty() || !std::filesystem::exists(dir / "sample_11.ldt")) LUMX_SKIP_WITHOUT_SHARED("data/photometry/123VincentB+eulumdat-ugr");
+  const Photometry ldt = read_photometry((dir / "sample_11.ldt").string());
+  const auto ies_path = lumx_test::unique_temp_path("sample_11_ugr.ies");
+  write_photometry(ldt, ies_path.string());
+  const Photometry ies = read_photometry(ies_path.string());
+  std::filesystem::remove(ies_path);
+  const UgrTable a = ugr_table(ldt), b = ugr_table(ies);
+  for (std::size_t r = 0; r < a.options.rooms.size(); ++r)
+    for (std::size_t k = 0; k < 5; ++k)
+      for (UgrView v : {UgrView::crosswise, UgrView::endwise}) EXPECT_NEAR(a.at(r, k, v), b.at(r, k, v), 0.05) << r << " " << k;
+}
