@@ -177,6 +177,16 @@ TEST(UgrTable, PointSourceIsALocatedError) {
     EXPECT_EQ(e.diagnostic().field, "luminous area");
     EXPECT_EQ(e.diagnostic().file, "synthetic");
   }
+  // An IES sign pattern outside LM-63-2019 Table 1 says so.
+  Photometry odd = lumx_test::rotational_photometry([](double) { return 100.0; }, 5.0, 0.34, -0.12);
+  odd.opening.height_m = 0.56;
+  try {
+    ugr_table(odd);
+    FAIL() << "no luminous area";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.diagnostic().field, "luminous area");
+    EXPECT_NE(e.diagnostic().message.find("Table 1"), std::string::npos) << e.what();
+  }
   // A luminaire that emits nothing has no glare to rate: a located error, not a table of NaN.
   Photometry dark = lumx_test::rotational_photometry([](double) { return 0.0; });
   try {

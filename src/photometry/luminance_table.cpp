@@ -17,7 +17,7 @@ LuminanceTable luminance_table(const Photometry& p, std::vector<double> c_deg, s
   const LuminousArea area = luminous_area(p);
   if (area.kind == LuminousArea::Kind::none)
     throw_at_line(p.source.file, p.source.format == "EULUMDAT" ? 16 : 0, "luminous area",
-                  "none given (a point source): luminance needs the luminous area");
+                  missing_luminous_area_reason(p) + ": luminance needs the luminous area");
   const IntensityTable t(p);
   LuminanceTable out;
   out.c_deg = std::move(c_deg);

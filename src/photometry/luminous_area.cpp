@@ -111,4 +111,12 @@ LuminousArea luminous_area(const Photometry& p) {
   return a;
 }
 
+std::string missing_luminous_area_reason(const Photometry& p) {
+  if (p.source.format != "EULUMDAT" && p.opening.shape() == LuminousShape::unknown)
+    return "the opening's signs (width " + std::to_string(p.opening.width_m) + ", length " +
+           std::to_string(p.opening.length_m) + ", height " + std::to_string(p.opening.height_m) +
+           " m) match no shape of LM-63-2019 Table 1";
+  return "none given (a point source)";
+}
+
 LUMX_NAMESPACE_END

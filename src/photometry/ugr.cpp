@@ -90,7 +90,7 @@ UgrTable ugr_table(const Photometry& p, const UgrTableOptions& o) {
   const LuminousArea area = luminous_area(p);
   if (area.kind == LuminousArea::Kind::none)
     throw_about(p, 16, "luminous area",
-                "none given (a point source): the UGR needs the luminous area to turn intensity into luminance");
+                missing_luminous_area_reason(p) + ": the UGR needs the luminous area to turn intensity into luminance");
   const IntensityTable t(p);
   UgrTable out;
   out.options = o;

@@ -9,6 +9,8 @@
 
 #include <glm/vec3.hpp>
 
+#include <string>
+
 LUMX_NAMESPACE_BEGIN
 
 /// Luminous parts in the photometric frame (+X = C0, +Y = C90, -Z = nadir), metres.
@@ -38,5 +40,9 @@ struct LuminousArea {
 /// the IES luminous opening (LM-63-2019 §5.11 Table 1). The rectangle's length lies along X (C0), as
 /// lumx maps both formats (docs/photometry.md). Kind::none for a point or an unknown sign pattern.
 LuminousArea luminous_area(const Photometry& p);
+
+/// Why luminous_area(p) is Kind::none, in words for an error message: a point (all sizes zero) or an
+/// IES sign pattern LM-63-2019 Table 1 does not list.
+std::string missing_luminous_area_reason(const Photometry& p);
 
 LUMX_NAMESPACE_END
