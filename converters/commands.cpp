@@ -5,6 +5,7 @@
 #include "commands.h"
 
 #include "cli_support.h"
+#include "metrics_commands.h"
 #include "polar_plot.h"
 
 #include <lumx/io/bundle_io.h>
@@ -101,6 +102,7 @@ int run_info(const InfoArgs& a) {
             {"shape", lumx::to_string(p.opening.shape())}}},
           {"lamps", lamps},
           {"tilt", p.tilt ? json{{"source", p.tilt->source}, {"pairs", p.tilt->angles_deg.size()}} : json(nullptr)},
+          {"metrics", metrics_json(p)},
           {"warnings", json::array()}};
       for (const auto& w : warnings) j["warnings"].push_back(diag_json(w));
       std::cout << j.dump(2, ' ', false, json::error_handler_t::replace) << "\n";
@@ -134,6 +136,7 @@ int run_info(const InfoArgs& a) {
     if (p.tilt)
       std::printf("tilt:          %s, %zu angles, lamp geometry %d\n", p.tilt->source.c_str(),
                   p.tilt->angles_deg.size(), p.tilt->lamp_geometry);
+    print_metrics_summary(p);
     return 0;
   });
 }
@@ -216,9 +219,17 @@ int run_convert(const ConvertArgs& a) {
 }
 
 int run_plot(const PlotArgs& a) {
-  if (is_bundle_path(a.file)) return run_bundle_plot(a);
+  if (is_bundle_path(a.file)) {
+    if (a.kind != "polar") {
+      std::fprintf(stderr, "%s: error: kind: --kind %s is for photometry files; bundles plot their APLs\n",
+                   a.file.c_str(), a.kind.c_str());
+      return 1;
+    }
+    return run_bundle_plot(a);
+  }
   return guarded(a.file, [&] {
     const lumx::Photometry p = load(a.file);
+    if (a.kind != "polar") return run_metric_plot(a, p);
     lumx::PolarPlotOptions o;
     o.title = a.title;  // empty: the diagram's own default (luminaire name, else file name)
     o.size_px = a.size_px;

@@ -39,6 +39,11 @@ struct PlotArgs {
   int apl = -1;    ///< bundles: draw this APL's map (-1: draw the level's APL positions)
   int size_px = 800;
   bool force_cd = false;
+  std::string kind = "polar";        ///< polar, isolux, isocandela, cone, ugr (photometry files)
+  double mounting_height_m = 3.0;    ///< isolux: luminaire above the plane
+  double tilt_deg = 0;               ///< isolux: aiming tilt about the C0-C180 axis
+  double spacing_to_height = 0.25;   ///< ugr: S/H of the luminaire grid
+  std::vector<double> distances_m;   ///< cone: distances (empty: 1 … 5 m)
 };
 
 int run_info(const InfoArgs& a);

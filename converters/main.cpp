@@ -99,7 +99,8 @@ const Command kCommands[] = {
                   "readers misplace it; by default it is written as 0..360)");
        c.callback([&st] { st = lumx_cli::run_convert(g_convert); });
      }},
-    {"plot", "Draw the polar intensity diagram (C0-C180 and C90-C270) as SVG or PNG; for a bundle, one APL's "
+    {"plot", "Draw the polar intensity diagram (C0-C180 and C90-C270), or with --kind the isolux, isocandela or cone "
+             "diagram or the UGR table, as SVG or PNG; for a bundle, one APL's "
              "map (--apl I) or a level's APL positions in three orthographic views",
      [](CLI::App& c, int& st) {
        c.add_option("file", g_plot.file, "IES or EULUMDAT file, or a bundle folder")->required();
@@ -109,6 +110,16 @@ const Command kCommands[] = {
        c.add_option("--title", g_plot.title, "title (default: luminaire name or file name)");
        c.add_option("--size", g_plot.size_px, "image size in pixels (default 800)")->check(CLI::Range(200, 8000));
        c.add_flag("--cd", g_plot.force_cd, "plot absolute cd even for relative photometry (default cd/klm)");
+       c.add_option("--kind", g_plot.kind, "photometry: polar (default), isolux, isocandela, cone or ugr")
+           ->check(CLI::IsMember({"polar", "isolux", "isocandela", "cone", "ugr"}));
+       c.add_option("--height", g_plot.mounting_height_m, "isolux: mounting height above the plane, m (default 3)")
+           ->check(CLI::Range(0.01, 1000.0));
+       c.add_option("--tilt", g_plot.tilt_deg, "isolux: aiming tilt about the C0-C180 axis, degrees (default 0)")
+           ->check(CLI::Range(0.0, 85.0));
+       c.add_option("--distances", g_plot.distances_m, "cone: distances along the axis, m (default 1 2 3 4 5)")
+           ->check(CLI::Range(0.001, 10000.0));
+       c.add_option("--spacing", g_plot.spacing_to_height, "ugr: luminaire spacing over H (default 0.25)")
+           ->check(CLI::Range(0.05, 4.0));
        c.callback([&st] { st = lumx_cli::run_plot(g_plot); });
      }},
     {"build", "Build a bundle from a rayset (TM-25, LightTools, Zemax, plain text): APL levels by agglomerative "
