@@ -212,7 +212,6 @@ class LineReader {
   std::uint64_t offset_ = 0;
   int line_ = 0;
   bool eof_ = false;
-  bool pending_cr_ = false;
 };
 
 /// Splits a line into numbers (blanks, tabs or commas between them). False if a token is not a finite

@@ -16,8 +16,7 @@ LUMX_NAMESPACE_BEGIN
 namespace detail {
 namespace {
 
-constexpr std::uint64_t kHeaderBytes = 256;
-constexpr std::uint64_t kFlagsEnd = 288;
+constexpr std::uint64_t kFlagsEnd = 288;  // the 256-byte numeric header, then eight 4-byte flags
 constexpr std::uint64_t kTextBytes = 4000;                            // 1000 UTF-32 code units
 constexpr std::uint64_t kPreambleBytes = kFlagsEnd + 9 * kTextBytes;  // 36288
 constexpr std::uint64_t kColumnNameBytes = 512;
