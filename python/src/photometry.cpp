@@ -264,6 +264,11 @@ void bind_photometry(py::module_& m) {
   m.def(
       "check",
       [](const std::string& path) {
+        std::string ext = std::filesystem::path(path).extension().string();
+        for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+        if (ext == ".glb" || ext == ".gltf")
+          throw py::value_error(path + ": glTF luminaires are checked by the bake component (`lumx check`), which "
+                                       "this module does not include");
         std::vector<lumx::Diagnostic> findings;
         {
           py::gil_scoped_release release;

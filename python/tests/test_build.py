@@ -64,3 +64,32 @@ def test_build_from_arrays_and_chunks(tmp_path):
     assert ma["levels"] == mb["levels"]
     with pytest.raises(ValueError):
         lumx.build(iter(chunks), str(tmp_path / "c.lumx"), levels=[1, 8], evaluate=False)
+
+
+def test_the_gil_is_released_while_building(tmp_path):
+    """A build in another thread leaves this one running Python: it counts on while the build works."""
+    import threading
+    import time
+
+    rays = synthetic_rays(200000, seed=9)
+    done = threading.Event()
+    counts = []
+
+    def work():
+        lumx.build(rays, str(tmp_path / "t.lumx"), levels=[1, 8, 64], threads=1)
+        done.set()
+
+    t = threading.Thread(target=work)
+    start = time.perf_counter()
+    t.start()
+    n = 0
+    while not done.is_set():
+        n += 1
+        if n % 100000 == 0:
+            counts.append(time.perf_counter() - start)
+    t.join()
+    seconds = time.perf_counter() - start
+    # Holding the GIL, the build would stall this loop for its whole length; released, the loop ticks
+    # through it (the interpreter still switches threads every 5 ms, hence no exact figure).
+    assert seconds > 0.2, "the build was too quick to tell"
+    assert len(counts) > 10 and max(b - a for a, b in zip([0.0] + counts, counts)) < seconds / 2

@@ -229,3 +229,11 @@ def test_reader_warnings_are_python_warnings(cli):
                      json.loads(cli("info", p, "--json").stdout)["warnings"])
         with pytest.raises(lumx.LumxWarning):
             lumx.read_photometry(str(noisy))
+
+
+def test_check_refuses_luminaires_it_cannot_read(tmp_path):
+    # glTF luminaires need the bake component, which the module does not include: a clear refusal,
+    # not a photometry parse error about a file that may well be valid.
+    (tmp_path / "lamp.glb").write_bytes(b"glTF")
+    with pytest.raises(ValueError, match="bake component"):
+        lumx.check(str(tmp_path / "lamp.glb"))
