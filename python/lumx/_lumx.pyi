@@ -328,6 +328,10 @@ class Bundle:
         """Irradiance, lx or W/m^2, at (N, 3) points (m) with (N, 3) normals."""
     def intensity(self, directions: ArrayLike, *, level: Optional[int] = None, rgb: bool = False) -> Union[float, FloatArray]:
         """Far-field intensity, cd or W/sr."""
+    def sample_emission(self, u: ArrayLike, *, level: Optional[int] = None) -> np.ndarray:
+        """Level.sample_emission on a level (default the finest)."""
+    def pdf(self, apl: ArrayLike, directions: ArrayLike, *, level: Optional[int] = None) -> Union[float, FloatArray]:
+        """Level.pdf on a level (default the finest), 1/sr."""
     def load_volume(self) -> RadianceVolume: ...
 
 def direction_to_uv(directions: ArrayLike) -> FloatArray: ...

@@ -122,7 +122,9 @@ void bind_build(py::module_& m) {
           bo.map_resolution = map_resolution;
           bo.rays_per_texel = rays_per_texel;
           bo.place_at_convergence = converge;
-          bo.line_clustering = cluster_by == "start" ? LC::start_points : cluster_by == "line" ? LC::lines : LC::automatic;
+          bo.line_clustering = cluster_by == "start"  ? LC::start_points
+                               : cluster_by == "line" ? LC::lines
+                                                      : LC::automatic;
           bo.apl_exponent = resolution_exponent;
           bo.map_smoothing_rays = smooth;
           bo.threads = threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
@@ -207,10 +209,10 @@ void bind_build(py::module_& m) {
       },
       py::arg("rays"), py::arg("out"), py::kw_only(), py::arg("levels") = std::vector<std::size_t>{1, 8, 64, 256, 512},
       py::arg("seeds") = 250000, py::arg("map_resolution") = 0, py::arg("rays_per_texel") = 8.0,
-      py::arg("patches") = 16, py::arg("evaluate") = true, py::arg("c_step_deg") = 2.5,
-      py::arg("gamma_step_deg") = 1.0, py::arg("efficacy_lm_per_w") = 0.0, py::arg("converge") = true,
-      py::arg("cluster_by") = "auto", py::arg("resolution_exponent") = 0.0, py::arg("smooth") = 0.0,
-      py::arg("threads") = 0, py::arg("progress") = py::none(),
+      py::arg("patches") = 16, py::arg("evaluate") = true, py::arg("c_step_deg") = 2.5, py::arg("gamma_step_deg") = 1.0,
+      py::arg("efficacy_lm_per_w") = 0.0, py::arg("converge") = true, py::arg("cluster_by") = "auto",
+      py::arg("resolution_exponent") = 0.0, py::arg("smooth") = 0.0, py::arg("threads") = 0,
+      py::arg("progress") = py::none(),
       "Builds a bundle from rays as `lumx build RAYS OUT` does (same options, same defaults, same result): "
       "APL levels by clustering, map resolutions and error tables from held-out rays (evaluate=False skips "
       "them), level 0's far field (c_step_deg, gamma_step_deg, degrees) attached as IES and EULUMDAT. `rays`: "

@@ -19,9 +19,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <stdexcept>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 
 namespace lumx_py {
 
@@ -30,8 +30,8 @@ namespace {
 /// One loaded level: set.levels holds exactly this level, with the bundle's units, channels and bounds.
 struct LoadedLevel {
   lumx::AplSet set;
-  std::size_t index = 0;    ///< level index in the bundle
-  int max_resolution = 0;   ///< as requested
+  std::size_t index = 0;   ///< level index in the bundle
+  int max_resolution = 0;  ///< as requested
   std::once_flag sampler_once;
   std::unique_ptr<lumx::AplEmissionSampler> sampler;
 
@@ -61,7 +61,9 @@ double point_random(std::uint64_t seed, std::uint64_t n) {
   return double(z >> 11) * (1.0 / 9007199254740992.0);
 }
 
-const char* channels_name(lumx::ChannelLayout c) { return c == lumx::ChannelLayout::rgb ? "rgb" : "luminance"; }
+const char* channels_name(lumx::ChannelLayout c) {
+  return c == lumx::ChannelLayout::rgb ? "rgb" : "luminance";
+}
 const char* quantity_name(lumx::PhotometricQuantity q) {
   return q == lumx::PhotometricQuantity::photometric ? "photometric" : "radiometric";
 }
@@ -195,7 +197,8 @@ py::array map_view(py::object level_obj, std::size_t apl) {
   const Level& l = level_obj.cast<const Level&>();
   const lumx::AplLevel& level = l.data->level();
   if (apl >= level.apls.size())
-    throw py::index_error("apl " + std::to_string(apl) + ": the level has " + std::to_string(level.apls.size()) + " APLs");
+    throw py::index_error("apl " + std::to_string(apl) + ": the level has " + std::to_string(level.apls.size()) +
+                          " APLs");
   const lumx::SphereMap& map = level.apls[apl].map;
   const py::ssize_t R = map.resolution(), W = map.width(), C = map.channels();
   const py::ssize_t f = sizeof(float);
@@ -210,17 +213,83 @@ py::array readonly(py::array a) {
   return a;
 }
 
+py::array sample_emission(const Level& l, const py::object& u) {
+  DoubleArray a = DoubleArray::ensure(u);
+  if (!a || a.ndim() != 2 || a.shape(1) != 3)
+    throw py::value_error("u: expected an (N, 3) array of uniform random numbers in [0, 1)");
+  const std::size_t n = std::size_t(a.shape(0));
+  const lumx::AplEmissionSampler* sampler = nullptr;
+  {
+    py::gil_scoped_release release;
+    sampler = &l.data->emission_sampler();
+  }
+  py::list fields;
+  fields.append(py::make_tuple("apl", "<i8"));
+  fields.append(py::make_tuple("position", "<f4", py::make_tuple(3)));
+  fields.append(py::make_tuple("direction", "<f4", py::make_tuple(3)));
+  fields.append(py::make_tuple("pdf_apl", "<f4"));
+  fields.append(py::make_tuple("pdf_direction", "<f4"));
+  fields.append(py::make_tuple("flux", "<f4", py::make_tuple(3)));
+  // Packed records (NumPy's default): apl at 0, position 8, direction 20, pdf_apl 32,
+  // pdf_direction 36, flux 40; 52 bytes.
+  py::array out(py::dtype::from_args(fields), std::vector<py::ssize_t>{py::ssize_t(n)});
+  if (out.itemsize() != 52) throw std::logic_error("sample_emission: unexpected record layout");
+  char* rec = static_cast<char*>(out.mutable_data());
+  const double* ud = a.data();
+  {
+    py::gil_scoped_release release;
+    for (std::size_t i = 0; i < n; ++i) {
+      const lumx::EmissionSample s = sampler->sample(float(ud[3 * i]), float(ud[3 * i + 1]), float(ud[3 * i + 2]));
+      const std::int64_t apl = s.valid() ? std::int64_t(s.apl) : -1;
+      const float values[11] = {s.position.x,  s.position.y,  s.position.z, s.direction.x,
+                                s.direction.y, s.direction.z, s.pdf_apl,    s.pdf_direction,
+                                s.flux.x,      s.flux.y,      s.flux.z};
+      std::memcpy(rec + 52 * i, &apl, sizeof apl);
+      std::memcpy(rec + 52 * i + 8, values, sizeof values);
+    }
+  }
+  return out;
+}
+
+py::object emission_pdf(const Level& l, const py::object& apl, const py::object& directions) {
+  const Vec3Rows d = vec3_rows(directions, "directions");
+  py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> ia =
+      py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(apl);
+  const bool one_per_direction =
+      ia && ((ia.ndim() == 1 && std::size_t(ia.shape(0)) == d.count) || (ia.ndim() == 0 && d.single));
+  if (!one_per_direction) throw py::value_error("apl: expected one APL index per direction");
+  const std::size_t count = l.data->level().size();
+  const std::int64_t* ip = ia.data();
+  py::array_t<double> out(py::ssize_t(d.count));
+  double* o = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    const lumx::AplEmissionSampler& s = l.data->emission_sampler();
+    for (std::size_t i = 0; i < d.count; ++i) {
+      if (ip[i] < 0 || std::size_t(ip[i]) >= count) {
+        o[i] = 0.0;  // an invalid sample's index
+        continue;
+      }
+      const glm::dvec3 w = d.at(i);
+      o[i] = s.pdf(std::size_t(ip[i]), glm::vec3(w / glm::length(w)));
+    }
+  }
+  return scalar_or_array(out, d.single);
+}
+
 }  // namespace
 
 void bind_bundle(py::module_& m) {
   py::class_<Level>(m, "Level",
                     "One loaded APL level: anisotropic point lights at positions (m) with intensity maps (cd or "
                     "W/sr) on equal-area sphere maps. Queries evaluate in C++ with the GIL released.")
-      .def_property_readonly("index", [](const Level& l) { return l.data->index; }, "level index in the bundle")
+      .def_property_readonly(
+          "index", [](const Level& l) { return l.data->index; }, "level index in the bundle")
       .def_property_readonly("apl_count", [](const Level& l) { return l.data->level().size(); })
       .def("__len__", [](const Level& l) { return l.data->level().size(); })
-      .def_property_readonly("map_resolution", [](const Level& l) { return l.data->level().map_resolution; },
-                             "R of the loaded maps (each map is an R x 2R image)")
+      .def_property_readonly(
+          "map_resolution", [](const Level& l) { return l.data->level().map_resolution; },
+          "R of the loaded maps (each map is an R x 2R image)")
       .def_property_readonly(
           "positions",
           [](const Level& l) {
@@ -256,13 +325,14 @@ void bind_bundle(py::module_& m) {
           "error_table",
           [](const Level& l) {
             const lumx::ErrorTable& e = l.data->level().error;
-            return py::make_tuple(py::array_t<double>(py::ssize_t(e.relative_distance.size()), e.relative_distance.data()),
-                                  py::array_t<double>(py::ssize_t(e.relative_rmse.size()), e.relative_rmse.data()));
+            return py::make_tuple(
+                py::array_t<double>(py::ssize_t(e.relative_distance.size()), e.relative_distance.data()),
+                py::array_t<double>(py::ssize_t(e.relative_rmse.size()), e.relative_rmse.data()));
           },
           "(relative distance d, relative RMSE) of the level's irradiance, measured on held-out rays; empty "
           "when the bundle has none")
-      .def_property_readonly("map_bytes", [](const Level& l) { return l.data->level().map_bytes(); },
-                             "bytes of map data in memory")
+      .def_property_readonly(
+          "map_bytes", [](const Level& l) { return l.data->level().map_bytes(); }, "bytes of map data in memory")
       .def("map", &map_view, py::arg("apl"),
            "APL `apl`'s intensity map, cd or W/sr, as a read-only (R, 2R, channels) float32 view (no copy); "
            "texel (x, y) holds the mean over its equal solid angle 4 pi / (2 R^2) sr. lumx.uv_to_direction "
@@ -290,82 +360,14 @@ void bind_bundle(py::module_& m) {
           py::arg("directions"), py::arg("rgb") = false,
           "Far-field intensity of the whole level towards each direction (sum of the APLs' maps, positions "
           "ignored), cd or W/sr: (N,) luminance, or (N, 3) channels with rgb=True.")
-      .def(
-          "sample_emission",
-          [](const Level& l, const py::object& u) {
-            DoubleArray a = DoubleArray::ensure(u);
-            if (!a || a.ndim() != 2 || a.shape(1) != 3)
-              throw py::value_error("u: expected an (N, 3) array of uniform random numbers in [0, 1)");
-            const std::size_t n = std::size_t(a.shape(0));
-            const lumx::AplEmissionSampler* sampler = nullptr;
-            {
-              py::gil_scoped_release release;
-              sampler = &l.data->emission_sampler();
-            }
-            py::list fields;
-            fields.append(py::make_tuple("apl", "<i8"));
-            fields.append(py::make_tuple("position", "<f4", py::make_tuple(3)));
-            fields.append(py::make_tuple("direction", "<f4", py::make_tuple(3)));
-            fields.append(py::make_tuple("pdf_apl", "<f4"));
-            fields.append(py::make_tuple("pdf_direction", "<f4"));
-            fields.append(py::make_tuple("flux", "<f4", py::make_tuple(3)));
-            // Packed records (NumPy's default): apl at 0, position 8, direction 20, pdf_apl 32,
-            // pdf_direction 36, flux 40; 52 bytes.
-            py::array out(py::dtype::from_args(fields), std::vector<py::ssize_t>{py::ssize_t(n)});
-            if (out.itemsize() != 52) throw std::logic_error("sample_emission: unexpected record layout");
-            char* rec = static_cast<char*>(out.mutable_data());
-            const double* ud = a.data();
-            {
-              py::gil_scoped_release release;
-              for (std::size_t i = 0; i < n; ++i) {
-                const lumx::EmissionSample s =
-                    sampler->sample(float(ud[3 * i]), float(ud[3 * i + 1]), float(ud[3 * i + 2]));
-                const std::int64_t apl = s.valid() ? std::int64_t(s.apl) : -1;
-                const float values[11] = {s.position.x,  s.position.y,  s.position.z, s.direction.x,
-                                          s.direction.y, s.direction.z, s.pdf_apl,    s.pdf_direction,
-                                          s.flux.x,      s.flux.y,      s.flux.z};
-                std::memcpy(rec + 52 * i, &apl, sizeof apl);
-                std::memcpy(rec + 52 * i + 8, values, sizeof values);
-              }
-            }
-            return out;
-          },
-          py::arg("u"),
-          "Emission samples (light tracing, photon mapping) from an (N, 3) array of uniform numbers in [0, 1): "
-          "a structured array with apl (-1 where invalid), position (3,) m, direction (3,), pdf_apl, "
-          "pdf_direction (per sr) and flux (3,) = I / (pdf_apl pdf_direction), lm or W; the mean of flux is the "
-          "level's flux.")
-      .def(
-          "pdf",
-          [](const Level& l, const py::object& apl, const py::object& directions) {
-            const Vec3Rows d = vec3_rows(directions, "directions");
-            py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> ia =
-                py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(apl);
-            const bool one_per_direction = ia && ((ia.ndim() == 1 && std::size_t(ia.shape(0)) == d.count) ||
-                                                  (ia.ndim() == 0 && d.single));
-            if (!one_per_direction)
-              throw py::value_error("apl: expected one APL index per direction");
-            const std::size_t count = l.data->level().size();
-            const std::int64_t* ip = ia.data();
-            py::array_t<double> out(py::ssize_t(d.count));
-            double* o = out.mutable_data();
-            {
-              py::gil_scoped_release release;
-              const lumx::AplEmissionSampler& s = l.data->emission_sampler();
-              for (std::size_t i = 0; i < d.count; ++i) {
-                if (ip[i] < 0 || std::size_t(ip[i]) >= count) {
-                  o[i] = 0.0;  // an invalid sample's index
-                  continue;
-                }
-                const glm::dvec3 w = d.at(i);
-                o[i] = s.pdf(std::size_t(ip[i]), glm::vec3(w / glm::length(w)));
-              }
-            }
-            return scalar_or_array(out, d.single);
-          },
-          py::arg("apl"), py::arg("directions"),
-          "Joint density pdf_apl(apl) * pdf_direction(apl, w) (per sr) of emission sampling, for MIS; equals "
-          "what sample_emission returned for its samples. 0 for apl = -1.")
+      .def("sample_emission", &sample_emission, py::arg("u"),
+           "Emission samples (light tracing, photon mapping) from an (N, 3) array of uniform numbers in [0, 1): "
+           "a structured array with apl (-1 where invalid), position (3,) m, direction (3,), pdf_apl, "
+           "pdf_direction (per sr) and flux (3,) = I / (pdf_apl pdf_direction), lm or W; the mean of flux is the "
+           "level's flux.")
+      .def("pdf", &emission_pdf, py::arg("apl"), py::arg("directions"),
+           "Joint density pdf_apl(apl) * pdf_direction(apl, w) (per sr) of emission sampling, for MIS; equals "
+           "what sample_emission returned for its samples. 0 for apl = -1.")
       .def(
           "choose_light",
           [](const Level& l, const py::object& points, const py::object& normals, const py::object& u) {
@@ -403,15 +405,22 @@ void bind_bundle(py::module_& m) {
   py::class_<lumx::RadianceVolume, std::shared_ptr<lumx::RadianceVolume>>(
       m, "RadianceVolume",
       "The luminaire's glow: a voxel grid (m) of spherical-harmonic radiance coefficients per channel.")
-      .def_property_readonly("counts", [](const lumx::RadianceVolume& v) {
-        return py::make_tuple(v.counts().x, v.counts().y, v.counts().z);
-      }, "voxels per axis (nx, ny, nz)")
-      .def_property_readonly("lo", [](const lumx::RadianceVolume& v) {
-        return py::make_tuple(v.bounds().lo.x, v.bounds().lo.y, v.bounds().lo.z);
-      }, "grid lower corner, m")
-      .def_property_readonly("hi", [](const lumx::RadianceVolume& v) {
-        return py::make_tuple(v.bounds().hi.x, v.bounds().hi.y, v.bounds().hi.z);
-      }, "grid upper corner, m")
+      .def_property_readonly(
+          "counts",
+          [](const lumx::RadianceVolume& v) { return py::make_tuple(v.counts().x, v.counts().y, v.counts().z); },
+          "voxels per axis (nx, ny, nz)")
+      .def_property_readonly(
+          "lo",
+          [](const lumx::RadianceVolume& v) {
+            return py::make_tuple(v.bounds().lo.x, v.bounds().lo.y, v.bounds().lo.z);
+          },
+          "grid lower corner, m")
+      .def_property_readonly(
+          "hi",
+          [](const lumx::RadianceVolume& v) {
+            return py::make_tuple(v.bounds().hi.x, v.bounds().hi.y, v.bounds().hi.z);
+          },
+          "grid upper corner, m")
       .def_property_readonly("voxel_size", &lumx::RadianceVolume::voxel_size, "edge of the cubic voxels, m")
       .def_property_readonly("bands", &lumx::RadianceVolume::bands, "SH bands (coefficients = bands^2)")
       .def_property_readonly("channels", &lumx::RadianceVolume::channels)
@@ -456,10 +465,12 @@ void bind_bundle(py::module_& m) {
            "Opens the bundle and reads its manifest. Raises lumx.Error (field names the manifest entry) or "
            "OSError.")
       .def_property_readonly("path", [](Bundle& b) { return b.path(); })
-      .def_property_readonly("quantity", [](Bundle& b) { return quantity_name(b.manifest().quantity); },
-                             "'photometric' (cd, lm, lx) or 'radiometric' (W/sr, W, W/m^2)")
-      .def_property_readonly("channels", [](Bundle& b) { return channels_name(b.manifest().channels); },
-                             "'luminance' (one channel Y) or 'rgb'")
+      .def_property_readonly(
+          "quantity", [](Bundle& b) { return quantity_name(b.manifest().quantity); },
+          "'photometric' (cd, lm, lx) or 'radiometric' (W/sr, W, W/m^2)")
+      .def_property_readonly(
+          "channels", [](Bundle& b) { return channels_name(b.manifest().channels); },
+          "'luminance' (one channel Y) or 'rgb'")
       .def_property_readonly("intensity_unit", [](Bundle& b) { return lumx::intensity_unit(b.manifest().quantity); })
       .def_property_readonly("flux_unit", [](Bundle& b) { return lumx::flux_unit(b.manifest().quantity); })
       .def_property_readonly("irradiance_unit", [](Bundle& b) { return lumx::irradiance_unit(b.manifest().quantity); })
@@ -516,8 +527,9 @@ void bind_bundle(py::module_& m) {
           py::arg("level") = py::none(), "a level's APL positions from the manifest, m, (N, 3) (no payload read)")
       .def_property_readonly("has_volume", [](Bundle& b) { return b.manifest().volume.has_value(); })
       .def_property_readonly("bytes_read", &Bundle::bytes_read, "bytes read from disk so far, manifest included")
-      .def_property_readonly("total_bytes", [](Bundle& b) { return b.manifest().total_bytes(); },
-                             "bytes of the manifest and every payload: what a full load reads")
+      .def_property_readonly(
+          "total_bytes", [](Bundle& b) { return b.manifest().total_bytes(); },
+          "bytes of the manifest and every payload: what a full load reads")
       .def_property_readonly(
           "attachments",
           [](Bundle& b) {
@@ -566,8 +578,8 @@ void bind_bundle(py::module_& m) {
       .def(
           "irradiance",
           [](Bundle& b, const py::object& points, const py::object& normals, const py::object& level,
-             const py::object& lod, const py::object& error_target, const py::object& u, std::uint64_t seed,
-             bool rgb, double min_distance) {
+             const py::object& lod, const py::object& error_target, const py::object& u, std::uint64_t seed, bool rgb,
+             double min_distance) {
             const Vec3Rows x = vec3_rows(points, "points");
             // Evaluated in float, as the CLI does; the level choice sees the points in double, as there.
             std::vector<glm::vec3> xf(x.count), nf;
@@ -639,6 +651,33 @@ void bind_bundle(py::module_& m) {
           "Far-field intensity, cd (or W/sr), towards directions (N, 3): the sum of a level's maps (default the "
           "finest level). (N,) luminance, or (N, 3) with rgb=True.")
       .def(
+          "sample_emission",
+          [](Bundle& b, const py::object& u, const py::object& level) {
+            const std::size_t k = b.level_index(level);
+            Level l;
+            {
+              py::gil_scoped_release release;
+              l.data = b.level(k, 0, false);
+            }
+            return sample_emission(l, u);
+          },
+          py::arg("u"), py::kw_only(), py::arg("level") = py::none(),
+          "Level.sample_emission on a level (default the finest), loaded at full resolution unless loaded "
+          "before: samples with position (m), direction, pdfs (per sr) and flux (lm or W).")
+      .def(
+          "pdf",
+          [](Bundle& b, const py::object& apl, const py::object& directions, const py::object& level) {
+            const std::size_t k = b.level_index(level);
+            Level l;
+            {
+              py::gil_scoped_release release;
+              l.data = b.level(k, 0, false);
+            }
+            return emission_pdf(l, apl, directions);
+          },
+          py::arg("apl"), py::arg("directions"), py::kw_only(), py::arg("level") = py::none(),
+          "Level.pdf on a level (default the finest): the joint emission density, per sr.")
+      .def(
           "load_volume",
           [](Bundle& b) {
             if (!b.manifest().volume) throw py::value_error("the bundle has no radiance volume");
@@ -689,8 +728,9 @@ void bind_bundle(py::module_& m) {
         }
         return out;
       },
-      py::arg("uv"), "Unit directions of sphere-map coordinates (..., 2) -> (..., 3); texel (x, y) of an R map has "
-                     "its centre at ((x + 0.5) / 2R, (y + 0.5) / R).");
+      py::arg("uv"),
+      "Unit directions of sphere-map coordinates (..., 2) -> (..., 3); texel (x, y) of an R map has "
+      "its centre at ((x + 0.5) / 2R, (y + 0.5) / R).");
 }
 
 }  // namespace lumx_py

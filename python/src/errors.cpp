@@ -19,7 +19,9 @@ namespace {
 PyObject* g_error = nullptr;
 PyObject* g_warning = nullptr;
 
-py::object optional_line(const lumx::Diagnostic& d) { return d.line > 0 ? py::object(py::int_(d.line)) : py::none(); }
+py::object optional_line(const lumx::Diagnostic& d) {
+  return d.line > 0 ? py::object(py::int_(d.line)) : py::none();
+}
 py::object optional_offset(const lumx::Diagnostic& d) {
   return d.byte_offset >= 0 ? py::object(py::int_(d.byte_offset)) : py::none();
 }
@@ -39,9 +41,9 @@ void attach_fields(py::handle target, const lumx::Diagnostic& d) {
 // lumx's I/O failures end in ": " + strerror(errno) (io/atomic_file.cpp, rays/rayset_common.cpp,
 // bundle/bundle_io.cpp); that suffix gives the errno back. 0: not an I/O failure.
 int io_errno(const lumx::Diagnostic& d) {
-  static const int candidates[] = {ENOENT, EACCES, EPERM,  EISDIR, ENOTDIR, ENOSPC, EIO,   EROFS,
-                                   EEXIST, ENOTEMPTY, EXDEV, EMFILE, ENFILE, ELOOP,  EBUSY, ENAMETOOLONG,
-                                   EDQUOT, EFBIG,     EINVAL};
+  static const int candidates[] = {ENOENT, EACCES,       EPERM,     EISDIR, ENOTDIR, ENOSPC, EIO,
+                                   EROFS,  EEXIST,       ENOTEMPTY, EXDEV,  EMFILE,  ENFILE, ELOOP,
+                                   EBUSY,  ENAMETOOLONG, EDQUOT,    EFBIG,  EINVAL};
   for (int e : candidates) {
     const std::string suffix = std::string(": ") + std::strerror(e);
     const std::string& m = d.message;
@@ -68,7 +70,9 @@ void raise_error(const lumx::Diagnostic& d) {
 
 }  // namespace
 
-py::object to_python(const lumx::Diagnostic& d) { return py::cast(d); }
+py::object to_python(const lumx::Diagnostic& d) {
+  return py::cast(d);
+}
 
 void WarningCollector::emit(int stacklevel) {
   std::vector<lumx::Diagnostic> items;
@@ -108,8 +112,8 @@ Vec3Rows vec3_rows(const py::handle& value, const char* what) {
     r.count = std::size_t(r.array.shape(0));
   } else {
     throw py::value_error(std::string(what) + ": expected shape (N, 3) or (3,), got " +
-                          std::string(py::str(py::tuple(py::cast(std::vector<py::ssize_t>(
-                              r.array.shape(), r.array.shape() + r.array.ndim()))))));
+                          std::string(py::str(py::tuple(
+                              py::cast(std::vector<py::ssize_t>(r.array.shape(), r.array.shape() + r.array.ndim()))))));
   }
   return r;
 }
@@ -136,8 +140,9 @@ void bind_errors(py::module_& m) {
   py::class_<lumx::Diagnostic>(m, "Finding",
                                "One located finding of a check or reader: where (file, line or byte offset), "
                                "which field, what, and how bad.")
-      .def_property_readonly("severity", [](const lumx::Diagnostic& d) { return lumx::to_string(d.severity); },
-                             "'error', 'warning' or 'note'")
+      .def_property_readonly(
+          "severity", [](const lumx::Diagnostic& d) { return lumx::to_string(d.severity); },
+          "'error', 'warning' or 'note'")
       .def_readonly("file", &lumx::Diagnostic::file, "the file (or bundle folder) the finding is about")
       .def_property_readonly("line", optional_line, "1-based line of a text file, or None")
       .def_property_readonly("byte_offset", optional_offset, "byte offset in a binary file, or None")

@@ -36,7 +36,9 @@ lumx::SpreadPlane plane_from(const std::string& name) {
 }
 
 // The table every query uses; built while the GIL is held (the candela views may be edited meanwhile).
-lumx::IntensityTable table_of(const lumx::Photometry& p) { return lumx::IntensityTable(p); }
+lumx::IntensityTable table_of(const lumx::Photometry& p) {
+  return lumx::IntensityTable(p);
+}
 
 bool is_rayset_file(const std::string& path) {
   std::error_code ec;
@@ -62,8 +64,7 @@ void bind_photometry(py::module_& m) {
                " deg>";
       });
 
-  py::class_<lumx::PhotometricSummary>(m, "Summary",
-                                       "The datasheet figures of a photometry (what `lumx info` prints).")
+  py::class_<lumx::PhotometricSummary>(m, "Summary", "The datasheet figures of a photometry (what `lumx info` prints).")
       .def_readonly("flux_lm", &lumx::PhotometricSummary::flux_lm, "luminaire flux, lm (exact integral of the table)")
       .def_readonly("rated_lamp_flux_lm", &lumx::PhotometricSummary::rated_lamp_flux_lm,
                     "sum of the lamp sets' rated flux, lm (0 for absolute photometry)")
@@ -93,10 +94,12 @@ void bind_photometry(py::module_& m) {
                                "Far-field photometry (IES LM-63 or EULUMDAT): the stored part of the intensity "
                                "table (cd) over horizontal and vertical angles (degrees), its symmetry, lamps "
                                "and descriptive data. Frame: +X = C0, +Y = C90, -Z = nadir; lengths in m.")
-      .def_property_readonly("type", [](const lumx::Photometry& p) { return lumx::to_string(p.type); },
-                             "photometric type: 'C', 'B' or 'A'")
-      .def_property_readonly("symmetry", [](const lumx::Photometry& p) { return lumx::to_string(p.symmetry); },
-                             "which part of the sphere is stored; the rest follows by mirroring")
+      .def_property_readonly(
+          "type", [](const lumx::Photometry& p) { return lumx::to_string(p.type); },
+          "photometric type: 'C', 'B' or 'A'")
+      .def_property_readonly(
+          "symmetry", [](const lumx::Photometry& p) { return lumx::to_string(p.symmetry); },
+          "which part of the sphere is stored; the rest follows by mirroring")
       .def_property_readonly(
           "horizontal_deg",
           [](py::object self) {
@@ -115,8 +118,7 @@ void bind_photometry(py::module_& m) {
           "candela",
           [](py::object self) {
             auto& p = self.cast<lumx::Photometry&>();
-            return view(p.candela, {py::ssize_t(p.horizontal_deg.size()), py::ssize_t(p.vertical_deg.size())},
-                        self);
+            return view(p.candela, {py::ssize_t(p.horizontal_deg.size()), py::ssize_t(p.vertical_deg.size())}, self);
           },
           "stored intensities, cd, shape (len(horizontal_deg), len(vertical_deg)): a view (no copy) of the "
           "table; the file's multiplier is already applied")
@@ -194,8 +196,7 @@ void bind_photometry(py::module_& m) {
           "Findings of strict validation (a list of lumx.Finding), located by the source lines when known.")
       .def(
           "write",
-          [](const lumx::Photometry& p, const std::string& path, int ies_version, int digits,
-             bool expand_c90_c270) {
+          [](const lumx::Photometry& p, const std::string& path, int ies_version, int digits, bool expand_c90_c270) {
             lumx::WriteOptions o;
             if (ies_version != 2002 && ies_version != 2019) throw py::value_error("ies_version: 2002 or 2019");
             o.ies.version = ies_version == 2002 ? lumx::IesVersion::lm63_2002 : lumx::IesVersion::lm63_2019;
@@ -232,14 +233,14 @@ void bind_photometry(py::module_& m) {
           },
           "the luminous opening: signed width (along C90), length (along C0) and height, m, and its shape")
       .def_property_readonly("file", [](const lumx::Photometry& p) { return p.source.file; })
-      .def_property_readonly("format", [](const lumx::Photometry& p) { return p.source.format; },
-                             "'IES' or 'EULUMDAT'")
-      .def_property_readonly("version", [](const lumx::Photometry& p) { return p.source.version; },
-                             "e.g. 'LM-63-2002'")
+      .def_property_readonly(
+          "format", [](const lumx::Photometry& p) { return p.source.format; }, "'IES' or 'EULUMDAT'")
+      .def_property_readonly(
+          "version", [](const lumx::Photometry& p) { return p.source.version; }, "e.g. 'LM-63-2002'")
       .def("__repr__", [](const lumx::Photometry& p) {
         return "<lumx.Photometry " + p.source.format + " type " + lumx::to_string(p.type) + ", " +
-               std::to_string(p.horizontal_deg.size()) + " x " + std::to_string(p.vertical_deg.size()) +
-               " angles, '" + p.source.file + "'>";
+               std::to_string(p.horizontal_deg.size()) + " x " + std::to_string(p.vertical_deg.size()) + " angles, '" +
+               p.source.file + "'>";
       });
 
   m.def(
@@ -267,8 +268,9 @@ void bind_photometry(py::module_& m) {
         std::string ext = std::filesystem::path(path).extension().string();
         for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
         if (ext == ".glb" || ext == ".gltf")
-          throw py::value_error(path + ": glTF luminaires are checked by the bake component (`lumx check`), which "
-                                       "this module does not include");
+          throw py::value_error(path +
+                                ": glTF luminaires are checked by the bake component (`lumx check`), which "
+                                "this module does not include");
         std::vector<lumx::Diagnostic> findings;
         {
           py::gil_scoped_release release;
@@ -291,6 +293,8 @@ void bind_photometry(py::module_& m) {
             }
           } catch (const lumx::Error& e) {
             findings.push_back(e.diagnostic());
+          } catch (const std::exception& e) {  // e.g. out of memory: a finding of this file, as `lumx check` has it
+            findings.push_back(lumx::Diagnostic{lumx::Severity::error, path, 0, -1, "file", e.what()});
           }
         }
         for (auto& d : findings)

@@ -22,12 +22,14 @@ lumx::FluxPreference flux_preference(const std::string& s) {
 }
 
 lumx::RaysetFormat format_from(const std::string& s) {
-  for (lumx::RaysetFormat f : {lumx::RaysetFormat::tm25, lumx::RaysetFormat::lighttools_binary,
-                               lumx::RaysetFormat::lighttools_text, lumx::RaysetFormat::zemax_binary,
-                               lumx::RaysetFormat::zemax_text, lumx::RaysetFormat::plain_text})
+  for (lumx::RaysetFormat f :
+       {lumx::RaysetFormat::tm25, lumx::RaysetFormat::lighttools_binary, lumx::RaysetFormat::lighttools_text,
+        lumx::RaysetFormat::zemax_binary, lumx::RaysetFormat::zemax_text, lumx::RaysetFormat::plain_text})
     if (s == lumx::to_string(f)) return f;
-  throw py::value_error("format: expected one of 'TM-25', 'LightTools binary', 'LightTools text', 'Zemax binary', "
-                        "'Zemax text', 'plain text'; got '" + s + "'");
+  throw py::value_error(
+      "format: expected one of 'TM-25', 'LightTools binary', 'LightTools text', 'Zemax binary', "
+      "'Zemax text', 'plain text'; got '" +
+      s + "'");
 }
 
 lumx::PhotometricQuantity quantity_from(const std::string& s) {
@@ -46,7 +48,8 @@ std::optional<FloatArray> column(const py::handle& value, const char* name) {
   if (py::isinstance<py::array>(value)) {
     py::array a = py::reinterpret_borrow<py::array>(value);
     py::object names = a.dtype().attr("names");
-    if (names.is_none()) throw py::value_error("rays: expected a structured array with fields position, direction, flux");
+    if (names.is_none())
+      throw py::value_error("rays: expected a structured array with fields position, direction, flux");
     bool found = false;
     for (auto n : names) found = found || n.cast<std::string>() == name;
     if (!found) return std::nullopt;
@@ -264,12 +267,16 @@ void bind_rays(py::module_& m) {
       .def_readonly("format", &lumx::RaysetInfo::format, "'TM-25', 'LightTools binary', ... ")
       .def_readonly("version", &lumx::RaysetInfo::version)
       .def_readonly("ray_count", &lumx::RaysetInfo::ray_count, "rays in the file")
-      .def_property_readonly("quantity", [](const lumx::RaysetInfo& i) { return quantity_name(i.quantity); },
-                             "'photometric' (flux in lm) or 'radiometric' (W)")
-      .def_property_readonly("flux_unit", [](const lumx::RaysetInfo& i) { return lumx::flux_unit(i.quantity); },
-                             "'lm' or 'W'")
       .def_property_readonly(
-          "header_flux", [](const lumx::RaysetInfo& i) { return std::isnan(i.header_flux) ? py::object(py::none()) : py::object(py::float_(i.header_flux)); },
+          "quantity", [](const lumx::RaysetInfo& i) { return quantity_name(i.quantity); },
+          "'photometric' (flux in lm) or 'radiometric' (W)")
+      .def_property_readonly(
+          "flux_unit", [](const lumx::RaysetInfo& i) { return lumx::flux_unit(i.quantity); }, "'lm' or 'W'")
+      .def_property_readonly(
+          "header_flux",
+          [](const lumx::RaysetInfo& i) {
+            return std::isnan(i.header_flux) ? py::object(py::none()) : py::object(py::float_(i.header_flux));
+          },
           "total flux the header states (lm or W), or None; never applied to the rays")
       .def_readonly("source_length_unit", &lumx::RaysetInfo::source_length_unit,
                     "the file's length unit before conversion to metres")
@@ -291,21 +298,23 @@ void bind_rays(py::module_& m) {
         return "<lumx.RaysetInfo " + i.format + ", " + std::to_string(i.ray_count) + " rays, '" + i.file + "'>";
       });
 
-  py::class_<RayFile>(m, "RayFile",
-                      "An open rayset (IES TM-25, LightTools, Zemax, plain text). Iterating yields chunks of at "
-                      "most chunk_rays rays as NumPy structured arrays with fields position (3,) m, direction "
-                      "(3,) unit, flux (lm or W per ray), and wavelength_nm when the file has one per ray; the "
-                      "file is read through a bounded window, never whole.")
-      .def_property_readonly("info", &RayFile::info, py::return_value_policy::reference_internal,
-                             "the header (lumx.RaysetInfo)")
+  py::class_<RayFile>(
+      m, "RayFile",
+      "An open rayset (IES TM-25, LightTools, Zemax, plain text). Iterating yields chunks of at "
+      "most chunk_rays rays as NumPy structured arrays with fields position (3,) m, direction "
+      "(3,) unit, flux (lm or W per ray), and wavelength_nm when the file has one per ray; the "
+      "file is read through a bounded window, never whole. Each `for` loop starts again from the first ray.")
+      .def_property_readonly("info", &RayFile::info, py::return_value_policy::copy,
+                             "the header (lumx.RaysetInfo; a copy, valid after close())")
       .def_property_readonly("chunk_rays", &RayFile::chunk_rays)
       .def("next_chunk", &RayFile::next_chunk, "The next chunk (structured array), or None after the last ray.")
       .def("rewind", &RayFile::rewind, "Start again from the first ray.")
       .def("close", &RayFile::close, "Release the file.")
-      .def("__iter__", [](py::object self) {
-        self.cast<RayFile&>().rewind();
-        return self;
-      })
+      .def("__iter__",
+           [](py::object self) {
+             self.cast<RayFile&>().rewind();
+             return self;
+           })
       .def("__next__",
            [](RayFile& f) {
              py::object c = f.next_chunk();
@@ -373,8 +382,8 @@ void bind_rays(py::module_& m) {
         std::unique_lock<std::mutex> file_lock;
         lumx::RaySource& source = rays_argument(rays, holder, file_lock, warnings);
         lumx::RaysetInfo info = source.info();
-        const bool from_file = py::isinstance<RayFile>(rays) || py::isinstance<py::str>(rays) ||
-                               py::hasattr(rays, "__fspath__");
+        const bool from_file =
+            py::isinstance<RayFile>(rays) || py::isinstance<py::str>(rays) || py::hasattr(rays, "__fspath__");
         if (!from_file) info = lumx::RaysetInfo{};
         if (!quantity.is_none()) info.quantity = quantity_from(quantity.cast<std::string>());
         lumx::Tm25WriteOptions o;

@@ -149,9 +149,14 @@ def test_intensity_at_texel_centres_integrates_to_the_maps(built):
 
 
 def test_emission_sampling(built):
-    level = lumx.Bundle(str(built)).load_level(2)
+    b = lumx.Bundle(str(built))
+    level = b.load_level(2)
     rng = np.random.default_rng(11)
-    s = level.sample_emission(rng.random((200000, 3)))
+    u = rng.random((200000, 3))
+    s = level.sample_emission(u)
+    np.testing.assert_array_equal(b.sample_emission(u[:100]), s[:100])
+    np.testing.assert_array_equal(b.pdf(s["apl"][:100], s["direction"][:100]),
+                                  level.pdf(s["apl"][:100], s["direction"][:100]))
     assert np.all(s["apl"] >= 0)
     # Each sample's flux is I / pdf: an unbiased estimate of the level's flux. Five standard errors.
     f = s["flux"][:, 0].astype(np.float64)

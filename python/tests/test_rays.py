@@ -190,10 +190,14 @@ def test_a_streamed_10m_ray_file_stays_within_a_memory_bound(tmp_path):
         assert r.returncode == 0, r.stderr
         return json.loads(r.stdout)
 
-    w = run("write", path, n, here)
-    assert path.stat().st_size > 28 * n
-    s = run("read", path, n)
-    print(f"\n{n} rays, {path.stat().st_size / 2**20:.0f} MiB on disk; writer grew by "
+    try:
+        w = run("write", path, n, here)
+        size = path.stat().st_size
+        s = run("read", path, n)
+    finally:
+        path.unlink(missing_ok=True)  # 280 MB: not left for pytest's kept temporary folders
+    assert size > 28 * n
+    print(f"\n{n} rays, {size / 2**20:.0f} MiB on disk; writer grew by "
           f"{(w['peak'] - w['baseline']) / 2**20:.1f} MiB, streaming reader by "
           f"{(s['peak'] - s['baseline']) / 2**20:.1f} MiB, read_all by {(s['held'] - s['baseline']) / 2**20:.1f} MiB")
     assert s["held"] - s["baseline"] >= 28 * n * 0.9  # the measure would see the rays held at once
