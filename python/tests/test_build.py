@@ -93,3 +93,19 @@ def test_the_gil_is_released_while_building(tmp_path):
     # through it (the interpreter still switches threads every 5 ms, hence no exact figure).
     assert seconds > 0.2, "the build was too quick to tell"
     assert len(counts) > 10 and max(b - a for a, b in zip([0.0] + counts, counts)) < seconds / 2
+
+
+def test_what_the_build_leaves_out_is_a_warning(tmp_path):
+    # Rays in W with no efficacy known: no far field can be attached, and the build says so.
+    rays_path = tmp_path / "watts.tm25ray"
+    lumx.write_tm25(str(rays_path), synthetic_rays(20000), quantity="radiometric")
+    with pytest.warns(lumx.LumxWarning, match="efficacy") as caught:
+        r = lumx.build(str(rays_path), str(tmp_path / "w.lumx"), levels=[1, 8], evaluate=False)
+    assert any(w.message.severity == "note" and w.message.file == str(rays_path) for w in caught)
+    assert np.isnan(r.far_field_flux_lm)
+    assert lumx.Bundle(str(tmp_path / "w.lumx")).attachments == []
+    r = lumx.build(str(rays_path), str(tmp_path / "v.lumx"), levels=[1, 8], evaluate=False, efficacy_lm_per_w=300)
+    assert "far_field.ies" in lumx.Bundle(str(tmp_path / "v.lumx")).attachments
+    # 300 lm/W times the rays' 2 W; the far field tabulates level 0's map on a 2.5 x 1 degree grid, whose
+    # bilinear table integrates a smooth distribution to well within 0.1 % (measured: 5e-5).
+    assert r.far_field_flux_lm == pytest.approx(300 * 20000 * float(np.float32(1e-4)), rel=1e-3)
