@@ -7,7 +7,8 @@ PKGS=(build-essential cmake ninja-build pkg-config
       libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev
       libcairo2-dev fonts-dejavu-core libopenexr-dev libssl-dev
       libdraco-dev libembree-dev libtbb-dev
-      python3 python3-jsonschema)
+      python3 python3-jsonschema
+      pybind11-dev python3-pybind11 python3-numpy python3-pytest)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
