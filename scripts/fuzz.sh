@@ -32,7 +32,8 @@ export LSAN_OPTIONS="suppressions=$(pwd)/scripts/lsan.supp"
 for t in "${targets[@]}"; do
   corpus=out/fuzz/$t/corpus
   mkdir -p "$corpus" "out/fuzz/$t/artifacts"
-  seed() { for f in "$@"; do [ -f "$f" ] && cp -n "$f" "$corpus/$(echo "$f" | tr '/' '_')" 2>/dev/null || true; done; }
+  # Seed names: the path with '/' as '_' and no leading dots (hidden files would not be counted).
+  seed() { for f in "$@"; do [ -f "$f" ] && cp -n "$f" "$corpus/$(echo "$f" | tr '/' '_' | sed 's/^[._]*//')" 2>/dev/null || true; done; }
   case $t in
     photometry) seed tests/data/bad/* tests/data/ldt/* samples/*.ies
                 [ -d "$shared" ] && while IFS= read -r f; do seed "$f"; done < <(find "$shared/photometry" -iname '*.ies' -o -iname '*.ldt' | head -200)

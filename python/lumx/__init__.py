@@ -38,15 +38,15 @@ from ._lumx import (  # noqa: F401  (the public API, re-exported)
     uv_to_direction,
     BuildResult,
     build,
+    BakePass,
+    BakeResult,
+    bake,
 )
-
-# lumx.bake (a glTF luminaire traced into a bundle) joins this list when the extension binds the bake
-# component (python/src/module.cpp).
 
 __all__ = [
     "Error", "LumxWarning", "Finding",
     "Photometry", "Summary", "Spread", "LampSet", "read_photometry", "check",
     "RaysetInfo", "RayFile", "open_rays", "ray_dtype", "write_tm25",
     "Bundle", "Level", "RadianceVolume", "direction_to_uv", "uv_to_direction",
-    "BuildResult", "build",
+    "BuildResult", "build", "BakePass", "BakeResult", "bake",
 ]

@@ -71,6 +71,7 @@ void bind_photometry(py::module_& m);
 void bind_rays(py::module_& m);
 void bind_bundle(py::module_& m);
 void bind_build(py::module_& m);
+void bind_bake(py::module_& m);
 
 /// Calls a Python progress callable from C++ work running without the GIL: takes the GIL, calls
 /// `callback(fraction, phase)`, and lets an exception in it (including KeyboardInterrupt, checked on

@@ -14,6 +14,5 @@ PYBIND11_MODULE(_lumx, m) {
   lumx_py::bind_rays(m);
   lumx_py::bind_bundle(m);
   lumx_py::bind_build(m);
-  // lumx.bake (glTF luminaire -> traced rays -> bundle) is bound here once the extension links the bake
-  // component (python/CMakeLists.txt), as bind_bake(m) in its own src/bake.cpp.
+  lumx_py::bind_bake(m);
 }
