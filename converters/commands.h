@@ -32,6 +32,8 @@ struct ConvertArgs {
   double tilt_deg = 0;               ///< installed tilt at which TILT multipliers are applied
   bool apply_tilt = false;
   bool keep_c90_c270 = false;        ///< write IES C90-C270 symmetry as 90..270 instead of 0..360
+  std::string tm33_version = "23";   ///< TM-33 edition written for .xml/.json: "23" (TM-33-23) or "18"
+  bool bundle = false;               ///< write a bundle folder whatever the output's extension
 };
 struct PlotArgs {
   std::string file, out, title;
