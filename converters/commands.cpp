@@ -60,6 +60,7 @@ void print_version() {
 
 int run_info(const InfoArgs& a) {
   if (is_bundle_path(a.file)) return run_bundle_info(a);
+  if (is_gldf_path(a.file)) return run_gldf_info(a);
   if (is_luminaire_path(a.file)) return run_luminaire_info(a);
   if (is_rayset_path(a.file)) return run_rayset_info(a);
   return guarded(a.file, [&] {
@@ -149,6 +150,8 @@ int run_check(const CheckArgs& a) {
     try {
       if (is_bundle_path(file)) {
         findings = lumx::check_bundle(file);
+      } else if (is_gldf_path(file)) {
+        findings = check_gldf_file(file, a.xsd);
       } else if (is_luminaire_path(file)) {
         findings = check_luminaire_file(file);
       } else if (is_rayset_path(file)) {
@@ -192,14 +195,17 @@ std::string lower_extension(const std::string& path) {
 
 int run_convert(const ConvertArgs& a) {
   if (is_bundle_path(a.in)) return run_convert_from_bundle(a);
+  if (is_gldf_path(a.in)) return run_gldf_extract(a);
   // The output's extension names its format; a bundle folder is written only for .lumx or --bundle.
   if (a.bundle || lower_extension(a.out) == ".lumx") return run_convert_to_bundle(a);
   if (!lumx::format_from_extension(a.out)) {
     lumx::Diagnostic d;
     d.file = a.out;
     d.field = "output format";
-    d.message = "unknown extension '" + lower_extension(a.out) +
-                "': use .ies, .ldt, .xml or .json (TM-33), .lumx (bundle), or --bundle for a bundle folder";
+    d.message = lower_extension(a.out) == ".gldf"
+                    ? "lumx reads GLDF containers but does not write them yet"
+                    : "unknown extension '" + lower_extension(a.out) +
+                          "': use .ies, .ldt, .xml or .json (TM-33), .lumx (bundle), or --bundle for a bundle folder";
     print_diag(d);
     return 1;
   }

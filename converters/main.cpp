@@ -64,6 +64,7 @@ const Command kCommands[] = {
        c.add_option("files", g_check.files, "files or bundle folders to check")->required();
        c.add_flag("--json", g_check.json, "print findings as JSON");
        c.add_flag("--strict", g_check.strict, "treat warnings as failures");
+       c.add_option("--xsd", g_check.xsd, "GLDF: validate product.xml against this schema file (gldf.xsd)");
        c.callback([&st] { st = lumx_cli::run_check(g_check); });
      }},
     {"convert", "Convert between IES, EULUMDAT and TM-33 (the output's extension names its format: .ies, .ldt, "

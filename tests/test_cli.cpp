@@ -178,6 +178,31 @@ TEST(Cli, ConvertOutputFormatFollowsTheExtension) {
   EXPECT_NE(lumx_test::read_text(d / "far.xml").find("<IntData"), std::string::npos);
 }
 
+TEST(Cli, GldfInfoCheckAndExtract) {
+  const fs::path shared = lumx_test::shared_dir();
+  if (shared.empty()) LUMX_SKIP_WITHOUT_SHARED("data/gldf");
+  const fs::path gldf = shared / "data/gldf/containers/Trilux_Belviso_S_CDP.gldf";
+  const fs::path xsd = shared / "data/gldf/xsd/gldf.xsd";
+  const CliRun info = run("info " + q(gldf), false);
+  ASSERT_EQ(info.status, 0) << info.out;
+  EXPECT_NE(info.out.find("ldc/TX054020.ldt"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("variant:"), std::string::npos) << info.out;
+  const auto j = nlohmann::json::parse(run("info --json " + q(gldf), false).out);
+  EXPECT_EQ(j["format"], "GLDF");
+  EXPECT_EQ(j["photometries"].size(), 2u);
+  const CliRun check = run("check --xsd " + q(xsd) + " " + q(gldf), false);
+  EXPECT_EQ(check.status, 0) << check.out;
+  EXPECT_EQ(check.out, gldf.string() + ": OK\n");
+  const fs::path d = scratch("gldf");
+  const CliRun x = run("convert " + q(gldf) + " " + q(d / "out"));
+  ASSERT_EQ(x.status, 0) << x.out;
+  EXPECT_TRUE(fs::exists(d / "out" / "TX054020.ldt"));
+  EXPECT_EQ(run("check " + q(d / "out" / "TX054019.ldt")).status, 0);
+  const CliRun w = run("convert " + q(d / "out" / "TX054019.ldt") + " " + q(d / "x.gldf"));
+  EXPECT_EQ(w.status, 1);
+  EXPECT_NE(w.out.find("does not write them"), std::string::npos) << w.out;
+}
+
 TEST(Cli, JsonStaysValidWithNonUtf8Bytes) {
   // A Latin-1 byte inside a bad number: the finding quotes it, and the JSON must still parse.
   const fs::path d = scratch("json");

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bad_input_support.h"
 #include "test_support.h"
 
 #include <algorithm>
@@ -429,4 +430,23 @@ TEST(Tm33BadInput, EveryTruncationIsALocatedError) {
     }
     EXPECT_EQ(errors, (good.size() - 3) / 7 + 1) << name;  // every cut is an error, and only lumx::Error
   }
+}
+
+TEST(Tm33BadInput, MutationsAndHostileNumbersLoadSanelyOrFailWithLumxErrors) {
+  // Whatever reads must also write and read back to the same table (the writer accepts all the reader
+  // produces).
+  auto through = [](bool json) {
+    return [json](const std::string& s) {
+      const Photometry p = json ? read_tm33_json(s, "m.json") : read_tm33_xml(s, "m.xml");
+      const Photometry q = json ? read_tm33_json(format_tm33_json(p), "w.json") : read_tm33_xml(format_tm33_xml(p), "w.xml");
+      if (q.candela != p.candela || q.horizontal_deg != p.horizontal_deg) ADD_FAILURE() << "write-read changed the table";
+      return p;
+    };
+  };
+  const std::string xml = lumx_test::read_text(fixture("troffer_tm33_18.xml"));
+  const std::string json = lumx_test::read_text(fixture("downlight_tm33_23.json"));
+  lumx_bad::never_crash_sweep(through(false), xml, "troffer_tm33_18.xml", 0x7333, 400);
+  lumx_bad::never_crash_sweep(through(true), json, "downlight_tm33_23.json", 0x7334, 400);
+  lumx_bad::token_sweep(through(false), xml, "troffer_tm33_18.xml");
+  lumx_bad::token_sweep(through(true), json, "downlight_tm33_23.json");
 }
