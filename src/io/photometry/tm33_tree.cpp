@@ -284,6 +284,8 @@ Tm33Node parse_tm33_json_tree(std::string_view text, const std::string& file) {
     const std::size_t colon = msg.find("parse error");
     if (colon != std::string::npos) msg = msg.substr(colon);
     throw_at_line(file, line, "JSON", msg);
+  } catch (const ojson::exception& e) {  // e.g. a number too large for a double: no position is known
+    throw_at_field(file, "JSON", e.what());
   }
   if (!j.is_object() || j.size() != 1)
     throw_at_field(file, "/", "a TM-33 JSON document is an object with one member, the root element");
