@@ -3,12 +3,8 @@
 // converters/build_command.h — `lumx build RAYS OUT`: a rayset in, a bundle out.
 #pragma once
 
-#include <lumx/apl/builder.h>
-#include <lumx/io/bundle_io.h>
+#include <lumx/io/bundle_builder.h>
 #include <lumx/rays/rayset.h>
-#include <lumx/volume/radiance_volume.h>
-
-#include <map>
 
 #include <cstddef>
 #include <string>
@@ -36,21 +32,15 @@ struct BuildArgs {
 
 int run_build(const BuildArgs& a);
 
-/// What a bundle gets beside its levels and far field: a radiance volume, more attachments, provenance.
-struct BundleExtras {
-  const lumx::RadianceVolume* volume = nullptr;
-  std::vector<lumx::BundleAttachment> attachments;
-  std::map<std::string, std::string> provenance;
-};
+/// The library options `lumx build`'s arguments stand for (lumx/io/bundle_builder.h).
+lumx::BundleBuildOptions bundle_options(const BuildArgs& a);
 
-/// `lumx build`'s work on rays already open (a.rays names them in messages and provenance): levels, error
-/// tables on held-out rays, the far field, the bundle at a.out. Throws lumx::Error; returns 0.
-int build_bundle(lumx::RaySource& rays, const BuildArgs& a, const BundleExtras& extras);
+/// `lumx build`'s work on rays already open (a.rays names them in messages): lumx::build_bundle to a.out
+/// with a progress bar, then its report and speed-against-error table printed. Throws lumx::Error; returns 0.
+int build_bundle(lumx::RaySource& rays, const BuildArgs& a, lumx::BundleBuildOptions o);
 
-/// The builder options a bundle was made with, as the JSON `lumx build` stores in its provenance
-/// ("build_options"), and back; `lumx eval` rebuilds from half of the source rays with them.
-std::string build_options_json(const lumx::AplBuildOptions& o);
-/// Throws std::invalid_argument naming the key when the text is not such JSON.
-lumx::AplBuildOptions build_options_from_json(const std::string& text);
+/// Prints what lumx::build_bundle did: levels, line convergence, fitted resolutions, notes (on stderr),
+/// the far field, the bundle's size and times, and the speed-against-error table.
+void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lumx::PhotometricQuantity quantity);
 
 }  // namespace lumx_cli

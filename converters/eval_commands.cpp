@@ -489,7 +489,7 @@ int run_rays(const EvalArgs& a) {
       lumx::throw_at_field(a.rays, "rays",
                            "these are the rays the bundle was built from and it does not record its build options: "
                            "give rays from another run, or --independent to grade it on its own rays anyway");
-    lumx::AplBuildOptions bo = build_options_from_json(opts->second);
+    lumx::AplBuildOptions bo = lumx::build_options_from_json(opts->second);
     bo.threads = std::max(1u, std::thread::hardware_concurrency());
     std::fprintf(stderr, "%s: note: these rays built the bundle; its levels are rebuilt from the even rays and graded "
                          "on the odd ones\n", a.rays.c_str());

@@ -166,7 +166,20 @@ const Command kCommands[] = {
      [](CLI::App& c, int& st) {
        c.add_option("luminaire", g_bake.luminaire, "glTF 2.0 luminaire (.glb or .gltf)")->required();
        c.add_option("output", g_bake.out, "bundle folder to write")->required();
-       c.add_option("--particles", g_bake.particles, "particles to trace (default 1000000)")
+       c.add_option("--particles", g_bake.particles, "particle budget: at most this many are traced (default 1000000)")
+           ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+       c.add_option("--target-error", g_bake.target_error,
+                    "stop once the finest level's relative RMSE of irradiance at single points, at --target-distance, "
+                    "graded on held-out particles, is known to be below this fraction (default 0.05; 0: trace the "
+                    "whole budget)")
+           ->check(CLI::Range(0.0, 10.0));
+       c.add_option("--target-distance", g_bake.target_distance,
+                    "relative distance d (luminaire diameters) of --target-error (default 1)")
+           ->check(CLI::Range(0.01, 1000.0));
+       c.add_option("--time-limit", g_bake.time_limit, "seconds: no pass starts that would end after it (default: none)")
+           ->check(CLI::Range(0.0, 1e7));
+       c.add_option("--pass-particles", g_bake.pass_particles,
+                    "particles per pass (default: 262144, then sized by the target error, or doubling)")
            ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
        c.add_option("--seed", g_bake.seed, "seed of the particles' random streams (default 1)");
        c.add_option("--volume-voxels", g_bake.volume_voxels,
@@ -176,8 +189,14 @@ const Command kCommands[] = {
            ->check(CLI::Range(1, 100000));
        c.add_option("--rays-out", g_bake.rays_out, "also keep the exits as an IES TM-25 rayset (a virtual near-field "
                                                    "goniophotometer)");
+       c.add_option("--preview", g_bake.preview,
+                    "folder for a preview after every pass: the intensity distribution filtered by pull-push, its "
+                    "histogram, its polar diagram, and a table of errors against passes");
+       c.add_option("--preview-resolution", g_bake.preview_resolution,
+                    "--preview: sphere-map resolution R, a power of two (default 64: 128 x 64 texels)")
+           ->check(CLI::IsMember({1, 2, 4, 8, 16, 32, 64, 128, 256, 512}));
        c.add_option("--levels", g_bake.build.levels, "APLs per level, increasing (default 1 8 64 256 512)");
-       c.add_flag("--no-eval", g_bake.build.no_eval, "skip the error evaluation (no error tables)");
+       c.add_flag("--no-eval", g_bake.build.no_eval, "skip the error evaluation (no error tables, no --target-error)");
        c.add_flag("--progress", g_bake.build.progress, "show the progress bar even when stderr is not a terminal");
        c.add_option("--threads", g_bake.build.threads, "threads (default: every core; the bundle is the same for "
                                                        "any count)")

@@ -22,7 +22,9 @@ class ProgressBar {
         start_(std::chrono::steady_clock::now()) {}
   ~ProgressBar() { done(); }
 
-  void update(double fraction, const char* phase) {
+  /// `status`, when given, replaces the computed rate and ETA (a caller that knows better, e.g. a bake's
+  /// passes and error).
+  void update(double fraction, const char* phase, const char* status = nullptr) {
     if (!enabled_) return;
     const auto now = std::chrono::steady_clock::now();
     if (fraction < 1.0 && now - last_ < std::chrono::milliseconds(100)) return;
@@ -32,8 +34,10 @@ class ProgressBar {
     const int width = 30, filled = int(fraction * width + 0.5);
     std::string bar(std::size_t(filled), '#');
     bar.resize(std::size_t(width), '.');
-    char tail[96] = "";
-    if (fraction > 0.01 && elapsed > 0.2) {
+    char tail[200] = "";
+    if (status) {
+      std::snprintf(tail, sizeof tail, "  %s", status);
+    } else if (fraction > 0.01 && elapsed > 0.2) {
       const double eta = elapsed * (1 - fraction) / fraction;
       if (total_ > 0)
         std::snprintf(tail, sizeof tail, "  %.2f M%s/s  ETA %.0f s", total_ * fraction / elapsed / 1e6, unit_, eta);

@@ -4,8 +4,9 @@
 # README command 1: build everything, then run the main job on what lumx generates itself (no data from
 # elsewhere is needed), all into out/demo/:
 #  0. four procedural glTF luminaires (samples/sample_luminaires.cpp); the troffer (three tubes behind a
-#     prismatic refractor) baked: 1 M light particles traced through its geometry -> a bundle with APL
-#     levels, held-out error tables, radiance volume and far field; its table, plots, far field as IES;
+#     prismatic refractor) baked: light particles traced through its geometry in passes until 5 % error
+#     at d = 1 on held-out particles or 1 M particles -> a bundle with APL levels, held-out error tables,
+#     radiance volume and far field; its table, plots, per-pass previews, far field as IES;
 #  1. a procedural 8-die LED strip written as a TM-25 rayset (samples/led_strip_rays.cpp) -> a lumx
 #     bundle: APL levels by clustering, each level's error against the rays, the far field; prints the
 #     speed-against-error table, writes its plots;
@@ -26,14 +27,16 @@ echo "== lumx info / check $lum/troffer.glb"
 "$lumx" check "$lum/troffer.glb"
 echo "== lumx bake $lum/troffer.glb -> $out/troffer.lumx (trace, APL levels, error tables, volume, far field)"
 rm -rf "$out/troffer.lumx"
-"$lumx" bake "$lum/troffer.glb" "$out/troffer.lumx" --particles 1000000 --rays-out "$out/troffer_exits.tm25ray" \
-  | tee "$out/troffer_bake.txt"
+rm -rf "$out/troffer_preview"
+"$lumx" bake "$lum/troffer.glb" "$out/troffer.lumx" --particles 1000000 --target-error 0.05 \
+  --rays-out "$out/troffer_exits.tm25ray" --preview "$out/troffer_preview" | tee "$out/troffer_bake.txt"
 "$lumx" check "$out/troffer.lumx"
 "$lumx" eval "$out/troffer.lumx" --rays "$out/troffer_exits.tm25ray" --plots "$out/troffer_plots" > "$out/troffer_eval.txt"
 "$lumx" convert "$out/troffer.lumx" "$out/troffer.ies"
 "$lumx" plot "$out/troffer.ies" -o "$out/troffer_polar.png"
 "$lumx" plot "$out/troffer.lumx" -o "$out/troffer_apls.svg"
-echo "(plots in $out/troffer_plots, far field $out/troffer.ies and its polar plot, APL picture $out/troffer_apls.svg)"
+echo "(plots in $out/troffer_plots, per-pass preview images and errors in $out/troffer_preview, far field"
+echo " $out/troffer.ies and its polar plot, APL picture $out/troffer_apls.svg)"
 rays=$out/led_strip.tm25ray
 echo "== samples/led_strip_rays.cpp writes a synthetic LED strip's rays -> $rays"
 "$dir/samples/led_strip_rays" "$rays" --rays 200000 --seed 1

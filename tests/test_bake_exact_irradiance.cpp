@@ -5,7 +5,10 @@
 // irradiance at single points of the measurement spheres is compared with the exact value there.
 //   * a Lambertian emissive disk: the exact field by quadrature over the disk (analytic_emitters.h);
 //   * a point light in a smooth absorbing glass ball: every exit leaves radially, so outside the ball the
-//     field is exactly a point source's at the centre with the exit flux, Φ cos θ / (4π r²).
+//     field is exactly a point source's at the centre with the exit flux, Φ cos θ / (4π r²);
+//   * a point light at the centre of a white Lambertian integrating sphere with a port: outside, the
+//     light through the port is the point source (in the port's cone) plus the port opening as a
+//     Lambertian disk of the wall's uniform radiance.
 #include "analytic_emitters.h"
 #include "luminaire_test_scenes.h"
 
@@ -39,10 +42,11 @@ struct ExitCollector : lumx::bake::ParticleSink {
 /// The finest level's relative RMSE against `exact` on each measurement sphere (patch centres), printed per
 /// level for the record.
 std::vector<double> baked_point_errors(const LuminaireScene& scene, const std::function<double(const glm::dvec3&, const glm::dvec3&)>& exact,
-                                       double* exit_flux, std::vector<double>* distances) {
+                                       double* exit_flux, std::vector<double>* distances,
+                                       std::uint64_t particles = kParticles) {
   const lumx::bake::Tracer tracer(scene);
   lumx::bake::TraceOptions o;
-  o.particles = kParticles;
+  o.particles = particles;
   ExitCollector exits;
   tracer.trace(o, exits);
   double flux = 0.0;
@@ -65,7 +69,7 @@ std::vector<double> baked_point_errors(const LuminaireScene& scene, const std::f
   *distances = ms.relative_distances();
   std::vector<double> finest;
   std::printf("%s: %llu particles, %zu exits, %.4g lm; point error against the exact irradiance, %%, at d =", scene.name.c_str(),
-              (unsigned long long)kParticles, exits.rays.size(), flux);
+              (unsigned long long)particles, exits.rays.size(), flux);
   for (double d : ms.relative_distances()) std::printf(" %g", d);
   std::printf("\n");
   for (std::size_t k = 0; k < set.levels.size(); ++k) {
@@ -134,6 +138,46 @@ TEST(BakeExactIrradiance, PointLightInAGlassBall) {
     if (d[s] >= 1) {
       EXPECT_LT(e[s], 0.01) << "d = " << d[s];
     }
+#endif
+    EXPECT_LT(e[s], 0.25) << "d = " << d[s];
+  }
+}
+
+// An integrating sphere whose white Lambertian wall (radius R, reflectance ρ, port of solid-angle fraction f)
+// itself glows with uniform luminance L_e: from any wall point, a wall element dA subtends the form factor
+// dA / (4π R²), so a uniform exitance M gives the uniform irradiance E = M (1 − f), and M = π L_e + ρ E
+// solves to M = π L_e / (1 − ρ (1 − f)). Seen from outside, the port is a Lambertian disk (radius R sin α
+// at height R cos α) of radiance M / π. (A point light inside would also shine straight through the port: a
+// cone with a sharp edge in the far field, which no map of finite resolution resolves at single points.)
+TEST(BakeExactIrradiance, IntegratingSphere) {
+  SceneBuilder b("baked integrating sphere");
+  const double rho = 0.8, cos_port = 0.9, R = 0.1, Le = 100.0;
+  Material wall = lambertian(rho);
+  wall.emissive = Rgb{1.0};
+  wall.emissive_strength = Le;
+  wall.double_sided = false;  // glows and scatters on the inside only
+  b.begin_part("wall", b.add_material(wall));
+  add_sphere(b, R, 48, 128, std::acos(cos_port), /*outward=*/false);
+  const double f = 0.5 * (1 - cos_port), M = lumx::kPi * Le / (1 - rho * (1 - f));
+  const double port_radius = R * std::sqrt(1 - cos_port * cos_port), port_height = R * cos_port;
+  const double port_flux = M * lumx::kPi * port_radius * port_radius;
+  const PlanarEmitter port("port", PlanarEmitter::Shape::disk, port_radius, 0.0, 1.0, port_flux);
+  double exit_flux = 0.0;
+  std::vector<double> d;
+  const std::vector<double> e = baked_point_errors(
+      b.scene(),
+      [&](const glm::dvec3& x, const glm::dvec3& n) { return port.irradiance(x - glm::dvec3(0, 0, port_height), n); },
+      &exit_flux, &d);
+  // Monte Carlo: ~1/6 of the particles leave, each with ~Φ/N: a standard error near 0.3 %; the polygonal
+  // wall and port differ from the sphere by < 5·10⁻⁴ in area.
+  EXPECT_NEAR(exit_flux, port_flux, 0.01 * port_flux);
+  for (std::size_t s = 0; s < d.size(); ++s) {
+    if (d[s] < 1) continue;  // spheres of d < 1 cut through the luminaire, whose wall the formula ignores
+#if !defined(__SANITIZE_ADDRESS__)
+    // 1 M particles, 279 000 exits: measured 5.8, 8.2, 5.6, 4.8 % at d = 1, 2, 5, 10. Not noise alone:
+    // 3.6 M particles (1 M exits, as many as the disk's) give 4.9, 8.0, 5.1, 3.9 %, where the fitted
+    // resolution is R 16 for the finer levels; levels 0–1 at R 32 reach 3.3–5.4 %.
+    EXPECT_LT(e[s], 0.10) << "d = " << d[s];
 #endif
     EXPECT_LT(e[s], 0.25) << "d = " << d[s];
   }

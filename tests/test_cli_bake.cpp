@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
 // `lumx bake`: a luminaire file in, a checked bundle out — the exits' flux exact where every particle leaves,
-// the same rays and maps for any thread count, the real flower lamp (plain and Draco), located errors.
+// passes, the target error and the preview, the same rays and maps for any thread count, the real flower
+// lamp (plain and Draco), located errors.
 #include "cli_test_support.h"
 #include "luminaire_test_scenes.h"
 #include "test_support.h"
@@ -83,6 +84,25 @@ TEST(CliBake, DiskBundleCarriesPiLAExactly) {
     if (m.attachments[i].first.name == "luminaire.glb") {
       EXPECT_EQ(bundle.read_attachment(i), bytes_of(glb));
     }
+  fs::remove_all(dir);
+}
+
+TEST(CliBake, TargetErrorPassesAndPreview) {
+  const fs::path dir = scratch("preview");
+  const fs::path glb = disk_luminaire(dir);
+  const CliRun r = run_cli("bake " + quoted(glb) + " " + quoted(dir / "bundle") +
+                           " --particles 600000 --levels 1 8 --target-error 0.0001 --target-distance 2 --preview " +
+                           quoted(dir / "preview") + " --preview-resolution 32");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("stopped by particle budget"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("pass 2:"), std::string::npos) << r.out;
+  for (const char* f : {"intensity.png", "polar.png", "intensity_pass01.png", "histogram_pass01.png",
+                        "polar_pass02.png", "convergence.txt"})
+    EXPECT_TRUE(fs::exists(dir / "preview" / f)) << f;
+  // One table row per pass, with the graded error of each.
+  const std::string table = bytes_of(dir / "preview" / "convergence.txt");
+  EXPECT_NE(table.find("\n   1      262144"), std::string::npos) << table;
+  EXPECT_NE(table.find("\n   2  "), std::string::npos) << table;
   fs::remove_all(dir);
 }
 

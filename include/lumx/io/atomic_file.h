@@ -14,6 +14,16 @@
 
 LUMX_NAMESPACE_BEGIN
 
+/// A fresh name for a temporary sibling of `target`: ".NAME.tmp-PID-N" in its folder (hidden, and on the
+/// same file system, so a rename to `target` is atomic). The process id lets remove_stale_temporaries tell
+/// a temporary of a killed writer from one still being written.
+std::string temporary_sibling_name(const std::string& target);
+
+/// Removes the temporaries of `target` (files or folders named as temporary_sibling_name makes them) left by
+/// processes that no longer run — a writer killed with SIGKILL cannot clean up after itself; the next
+/// write of the same target does. Best effort: what cannot be removed is left.
+void remove_stale_temporaries(const std::string& target);
+
 /// Replaces `path` with `bytes`. Throws lumx::Error naming the path and the failing step.
 void write_file_atomically(const std::string& path, std::string_view bytes);
 

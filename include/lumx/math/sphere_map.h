@@ -144,6 +144,21 @@ inline void texel_of(const glm::vec3& w, int resolution, int& x, int& y) {
   y = std::min(resolution - 1, int(s.y * float(resolution)));
 }
 
+/// Index (y · 2R + x) of texel (lx, ly) of square `half` (0: left, upper hemisphere; 1: right) in a map of
+/// square resolution R, where lx or ly may be −1 or R: outside a square's edge lies the mirror texel of the
+/// other square (the equator seam rule of the header comment). Each edge crossed flips to the other
+/// square; past a corner both edges are crossed, which flips back (the texel diagonally past a corner is
+/// the square's own corner texel).
+inline std::size_t seam_texel_index(int R, int half, int lx, int ly) {
+  int flips = 0;
+  if (lx < 0) lx = 0, ++flips;
+  else if (lx >= R) lx = R - 1, ++flips;
+  if (ly < 0) ly = 0, ++flips;
+  else if (ly >= R) ly = R - 1, ++flips;
+  half ^= flips & 1;
+  return std::size_t(ly) * std::size_t(2 * R) + std::size_t(half) * std::size_t(R) + std::size_t(lx);
+}
+
 /// Solid angle of one texel of a map of square resolution R: 4π / (2R²) sr.
 inline double texel_solid_angle(int resolution) {
   return 4.0 * kPi / (2.0 * double(resolution) * double(resolution));
@@ -336,16 +351,7 @@ class SphereMap {
   /// Texel (lx, ly) of square `half`, where lx or ly may be −1 or R: outside a square's edge (or corner)
   /// lies the mirror texel of the other square (the equator seam rule).
   const float* fetch(int half, int lx, int ly) const {
-    const int R = resolution_;
-    // Each edge crossed flips to the other square; past a corner both edges are crossed, which flips
-    // back (the texel diagonally past a corner is the square's own corner texel).
-    int flips = 0;
-    if (lx < 0) lx = 0, ++flips;
-    else if (lx >= R) lx = R - 1, ++flips;
-    if (ly < 0) ly = 0, ++flips;
-    else if (ly >= R) ly = R - 1, ++flips;
-    half ^= flips & 1;
-    return values_.data() + (std::size_t(ly) * width() + std::size_t(half) * R + lx) * channels_;
+    return values_.data() + sphere_map::seam_texel_index(resolution_, half, lx, ly) * std::size_t(channels_);
   }
   static glm::vec3 load3(const float* p) { return {p[0], p[1], p[2]}; }
 

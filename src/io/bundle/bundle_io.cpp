@@ -98,12 +98,7 @@ void fsync_folder(const std::string& folder) {
   ::close(fd);
 }
 
-std::string temporary_sibling(const fs::path& target) {
-  static std::atomic<unsigned> counter{0};
-  return (target.parent_path() / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                                  std::to_string(counter++)))
-      .string();
-}
+std::string temporary_sibling(const fs::path& target) { return temporary_sibling_name(target.string()); }
 
 /// The folder to write: absolute, normalised, without a trailing separator; a symbolic link is followed
 /// so that the bundle it points to is replaced and the link keeps pointing at it.
@@ -188,6 +183,7 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
   const bool exists = fs::exists(target, ec);
   if (exists) require_replaceable_bundle(target, path);
 
+  remove_stale_temporaries(target.string());  // of a writer killed mid-write
   const std::string tmp = temporary_sibling(target);
   try {
     fs::create_directories(fs::path(tmp) / "levels");

@@ -4,13 +4,14 @@
 #include "io/rays/rayset_common.h"
 #include "io/text_scanner.h"
 
+#include <lumx/io/atomic_file.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <random>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -446,11 +447,8 @@ bool utf8_to_utf32(std::string_view s, std::u32string& out) {
 // ---- AtomicStreamFile ----
 
 AtomicStreamFile::AtomicStreamFile(const std::string& path) : path_(path) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::random_device rd;
-  tmp_ = (dir / ("." + target.filename().string() + ".tmp" + std::to_string(rd()))).string();
+  remove_stale_temporaries(path);
+  tmp_ = temporary_sibling_name(path);
   fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     const int err = errno;
