@@ -140,7 +140,7 @@ int run_convert_to_bundle(const ConvertArgs& a) {
 int run_convert_from_bundle(const ConvertArgs& a) {
   return guarded(a.in, [&] {
     if (!lumx::format_from_extension(a.out))
-      throw std::invalid_argument(a.out + ": the output of a bundle conversion must be .ies or .ldt");
+      throw std::invalid_argument(a.out + ": the output of a bundle conversion must be .ies, .ldt, .xml or .json");
     const lumx::BundleReader reader(a.in);
     const std::size_t k = pick_level(reader.manifest(), a.level, 0);
     lumx::AplSet set = reader.empty_set();

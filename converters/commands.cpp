@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -49,15 +50,18 @@ json spread_json(const lumx::Spread& s) {
 
 void print_version() {
   std::printf("lumx %s (ABI namespace lumx::%s)\n", lumx::kLibraryVersion, lumx::kAbiNamespace);
-  std::printf("file formats read: IES %s, %s, %s, %s, %s; %s\n", lumx::file_format::kIes1986,
-              lumx::file_format::kIes1991, lumx::file_format::kIes1995, lumx::file_format::kIes2002,
-              lumx::file_format::kIes2019, lumx::file_format::kEulumdat);
-  std::printf("file formats written: IES %s (default), %s; %s\n", lumx::file_format::kIes2019,
-              lumx::file_format::kIes2002, lumx::file_format::kEulumdat);
+  std::printf("file formats read: IES %s, %s, %s, %s, %s; %s; IES %s and %s (XML, JSON)\n",
+              lumx::file_format::kIes1986, lumx::file_format::kIes1991, lumx::file_format::kIes1995,
+              lumx::file_format::kIes2002, lumx::file_format::kIes2019, lumx::file_format::kEulumdat,
+              lumx::file_format::kTm33_18, lumx::file_format::kTm33_23);
+  std::printf("file formats written: IES %s (default), %s; %s; IES %s (default), %s (XML, JSON)\n",
+              lumx::file_format::kIes2019, lumx::file_format::kIes2002, lumx::file_format::kEulumdat,
+              lumx::file_format::kTm33_23, lumx::file_format::kTm33_18);
 }
 
 int run_info(const InfoArgs& a) {
   if (is_bundle_path(a.file)) return run_bundle_info(a);
+  if (is_gldf_path(a.file)) return run_gldf_info(a);
   if (is_luminaire_path(a.file)) return run_luminaire_info(a);
   if (is_rayset_path(a.file)) return run_rayset_info(a);
   return guarded(a.file, [&] {
@@ -149,6 +153,8 @@ int run_check(const CheckArgs& a) {
     try {
       if (is_bundle_path(file)) {
         findings = lumx::check_bundle(file);
+      } else if (is_gldf_path(file)) {
+        findings = check_gldf_file(file, a.xsd);
       } else if (is_luminaire_path(file)) {
         findings = check_luminaire_file(file);
       } else if (is_rayset_path(file)) {
@@ -183,9 +189,29 @@ int run_check(const CheckArgs& a) {
   return status;
 }
 
+/// Lower-case extension of a path ("" if none).
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
 int run_convert(const ConvertArgs& a) {
   if (is_bundle_path(a.in)) return run_convert_from_bundle(a);
-  if (!lumx::format_from_extension(a.out)) return run_convert_to_bundle(a);
+  if (is_gldf_path(a.in)) return run_gldf_extract(a);
+  // The output's extension names its format; a bundle folder is written only for .lumx or --bundle.
+  if (a.bundle || lower_extension(a.out) == ".lumx") return run_convert_to_bundle(a);
+  if (!lumx::format_from_extension(a.out)) {
+    lumx::Diagnostic d;
+    d.file = a.out;
+    d.field = "output format";
+    d.message = lower_extension(a.out) == ".gldf"
+                    ? "lumx reads GLDF containers but does not write them yet"
+                    : "unknown extension '" + lower_extension(a.out) +
+                          "': use .ies, .ldt, .xml or .json (TM-33), .lumx (bundle), or --bundle for a bundle folder";
+    print_diag(d);
+    return 1;
+  }
   return guarded(a.in, [&] {
     lumx::Photometry p = load(a.in);
     if (a.apply_tilt) {
@@ -211,6 +237,7 @@ int run_convert(const ConvertArgs& a) {
     w.ies.significant_digits = a.digits;
     w.ies.expand_c90_c270 = !a.keep_c90_c270;
     w.ldt.significant_digits = a.digits;
+    w.tm33.version = a.tm33_version == "18" ? lumx::Tm33Version::tm33_18 : lumx::Tm33Version::tm33_23;
     const double f0 = lumx::IntensityTable(p).flux_lm();  // before writing: a failure must not replace the output
     lumx::write_photometry(p, a.out, w);
     std::printf("%s -> %s (flux %.2f lm)\n", a.in.c_str(), a.out.c_str(), f0);

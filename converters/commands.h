@@ -18,6 +18,7 @@ struct CheckArgs {
   std::vector<std::string> files;
   bool json = false;
   bool strict = false;  ///< warnings count as failures
+  std::string xsd;      ///< GLDF: validate product.xml against this schema (gldf.xsd)
 };
 struct ConvertArgs {
   std::string in, out;
@@ -32,6 +33,8 @@ struct ConvertArgs {
   double tilt_deg = 0;               ///< installed tilt at which TILT multipliers are applied
   bool apply_tilt = false;
   bool keep_c90_c270 = false;        ///< write IES C90-C270 symmetry as 90..270 instead of 0..360
+  std::string tm33_version = "23";   ///< TM-33 edition written for .xml/.json: "23" (TM-33-23) or "18"
+  bool bundle = false;               ///< write a bundle folder whatever the output's extension
 };
 struct PlotArgs {
   std::string file, out, title;
@@ -72,6 +75,14 @@ bool is_luminaire_path(const std::string& path);
 /// findings of reading and checking the scene (lumx::bake::check_luminaire).
 int run_luminaire_info(const InfoArgs& a);
 std::vector<lumx::Diagnostic> check_luminaire_file(const std::string& path);
+
+/// True when `path` names a GLDF container (.gldf, by extension; gldf_commands.cpp).
+bool is_gldf_path(const std::string& path);
+/// GLDF variants: info (products, variants, emitters, photometry and geometry files), the findings of
+/// check_gldf (archive, XSD, references, photometry inside), and extraction of the photometry files.
+int run_gldf_info(const InfoArgs& a);
+std::vector<lumx::Diagnostic> check_gldf_file(const std::string& path, const std::string& xsd);
+int run_gldf_extract(const ConvertArgs& a);
 
 /// Prints the library, ABI and file-format versions.
 void print_version();

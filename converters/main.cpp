@@ -64,13 +64,20 @@ const Command kCommands[] = {
        c.add_option("files", g_check.files, "files or bundle folders to check")->required();
        c.add_flag("--json", g_check.json, "print findings as JSON");
        c.add_flag("--strict", g_check.strict, "treat warnings as failures");
+       c.add_option("--xsd", g_check.xsd, "GLDF: validate product.xml against this schema file (gldf.xsd)");
        c.callback([&st] { st = lumx_cli::run_check(g_check); });
      }},
-    {"convert", "Convert between IES and EULUMDAT (format from the extensions); photometry to a one-APL "
-                "bundle (output without .ies/.ldt); a bundle level's far field to IES or EULUMDAT",
+    {"convert", "Convert between IES, EULUMDAT and TM-33 (the output's extension names its format: .ies, .ldt, "
+                ".xml or .json for TM-33); photometry to a one-APL bundle (.lumx or --bundle); a bundle level's "
+                "far field to any of the photometry formats",
      [](CLI::App& c, int& st) {
        c.add_option("input", g_convert.in, "input file or bundle folder")->required();
-       c.add_option("output", g_convert.out, "output file (.ies or .ldt) or bundle folder")->required();
+       c.add_option("output", g_convert.out, "output file (.ies, .ldt, .xml, .json) or bundle folder (.lumx)")
+           ->required();
+       c.add_flag("--bundle", g_convert.bundle, "photometry -> bundle folder whatever the output's extension");
+       c.add_option("--tm33-version", g_convert.tm33_version,
+                    "TM-33 edition written to .xml/.json: 23 (TM-33-23, default) or 18 (TM-33-18 / ATLA S001)")
+           ->check(CLI::IsMember({"18", "23"}));
        c.add_option("--map-resolution", g_convert.map_resolution,
                     "photometry -> bundle: map resolution R (image 2R x R, default 64)")
            ->check(CLI::Range(1, 4096));

@@ -5,7 +5,7 @@
 set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config
       libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev
-      libcairo2-dev fonts-dejavu-core libopenexr-dev libssl-dev
+      libcairo2-dev fonts-dejavu-core libopenexr-dev libssl-dev libxml2-dev libzip-dev
       libdraco-dev libembree-dev libtbb-dev
       python3 python3-jsonschema
       pybind11-dev python3-pybind11 python3-numpy python3-pytest)

@@ -143,6 +143,66 @@ TEST(Cli, FailedConvertLeavesThePreviousFile) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "temporary file left: " << e.path();
 }
 
+TEST(Cli, ConvertOutputFormatFollowsTheExtension) {
+  const fs::path d = scratch("extension");
+  // TM-33: .xml and .json; --tm33-version 18 writes the TM-33-18 root.
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(d / "s.xml")).status, 0);
+  const std::string xml = lumx_test::read_text(d / "s.xml");
+  EXPECT_EQ(xml.rfind("<?xml", 0), 0u);
+  EXPECT_NE(xml.find("<IESTM33-22>"), std::string::npos);
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(d / "s.json")).status, 0);
+  EXPECT_TRUE(nlohmann::json::parse(lumx_test::read_text(d / "s.json")).contains("IESTM33-22"));
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(d / "s18.xml") + " --tm33-version 18").status, 0);
+  EXPECT_NE(lumx_test::read_text(d / "s18.xml").find("<IESTM33>"), std::string::npos);
+  // TM-33 in, EULUMDAT out: the flux survives; info and check read TM-33.
+  ASSERT_EQ(run("convert " + q(d / "s.json") + " " + q(d / "back.ldt")).status, 0);
+  const auto a = nlohmann::json::parse(run("info --json " + q(kSample), false).out);
+  const auto b = nlohmann::json::parse(run("info --json " + q(d / "back.ldt"), false).out);
+  const auto c = nlohmann::json::parse(run("info --json " + q(d / "s.xml"), false).out);
+  EXPECT_NEAR(b["flux_lm"].get<double>(), a["flux_lm"].get<double>(), 1e-6 * a["flux_lm"].get<double>());
+  EXPECT_EQ(c["format"], "TM-33");
+  EXPECT_EQ(c["flux_lm"].get<double>(), a["flux_lm"].get<double>());
+  EXPECT_EQ(run("check " + q(d / "s.xml")).status, 0);
+  // An unknown extension is an error, and nothing is written.
+  const CliRun u = run("convert " + q(kSample) + " " + q(d / "y.txt"));
+  EXPECT_EQ(u.status, 1);
+  EXPECT_NE(u.out.find("unknown extension '.txt'"), std::string::npos) << u.out;
+  EXPECT_FALSE(fs::exists(d / "y.txt"));
+  // A bundle: .lumx, or any name with --bundle.
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(d / "b.lumx")).status, 0);
+  EXPECT_TRUE(fs::exists(d / "b.lumx" / "manifest.json"));
+  ASSERT_EQ(run("convert " + q(kSample) + " " + q(d / "folder") + " --bundle").status, 0);
+  EXPECT_TRUE(fs::exists(d / "folder" / "manifest.json"));
+  // A bundle's far field to TM-33.
+  ASSERT_EQ(run("convert " + q(d / "b.lumx") + " " + q(d / "far.xml")).status, 0);
+  EXPECT_NE(lumx_test::read_text(d / "far.xml").find("<IntData"), std::string::npos);
+}
+
+TEST(Cli, GldfInfoCheckAndExtract) {
+  const fs::path shared = lumx_test::shared_dir();
+  if (shared.empty()) LUMX_SKIP_WITHOUT_SHARED("data/gldf");
+  const fs::path gldf = shared / "data/gldf/containers/Trilux_Belviso_S_CDP.gldf";
+  const fs::path xsd = shared / "data/gldf/xsd/gldf.xsd";
+  const CliRun info = run("info " + q(gldf), false);
+  ASSERT_EQ(info.status, 0) << info.out;
+  EXPECT_NE(info.out.find("ldc/TX054020.ldt"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("variant:"), std::string::npos) << info.out;
+  const auto j = nlohmann::json::parse(run("info --json " + q(gldf), false).out);
+  EXPECT_EQ(j["format"], "GLDF");
+  EXPECT_EQ(j["photometries"].size(), 2u);
+  const CliRun check = run("check --xsd " + q(xsd) + " " + q(gldf), false);
+  EXPECT_EQ(check.status, 0) << check.out;
+  EXPECT_EQ(check.out, gldf.string() + ": OK\n");
+  const fs::path d = scratch("gldf");
+  const CliRun x = run("convert " + q(gldf) + " " + q(d / "out"));
+  ASSERT_EQ(x.status, 0) << x.out;
+  EXPECT_TRUE(fs::exists(d / "out" / "TX054020.ldt"));
+  EXPECT_EQ(run("check " + q(d / "out" / "TX054019.ldt")).status, 0);
+  const CliRun w = run("convert " + q(d / "out" / "TX054019.ldt") + " " + q(d / "x.gldf"));
+  EXPECT_EQ(w.status, 1);
+  EXPECT_NE(w.out.find("does not write them"), std::string::npos) << w.out;
+}
+
 TEST(Cli, JsonStaysValidWithNonUtf8Bytes) {
   // A Latin-1 byte inside a bad number: the finding quotes it, and the JSON must still parse.
   const fs::path d = scratch("json");

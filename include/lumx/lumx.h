@@ -46,4 +46,6 @@
 #include <lumx/io/atomic_file.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
+#include <lumx/io/tm33_io.h>
+#include <lumx/io/gldf_io.h>
 #include <lumx/io/rayset_io.h>

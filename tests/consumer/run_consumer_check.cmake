@@ -4,7 +4,8 @@
 #  1. builds tests/consumer/core (COMPONENTS core) and runs it on SAMPLE;
 #  2. checks that the core consumer's link line and its shared-library dependencies name no ray tracer,
 #     task scheduler, glTF/mesh codec, plotting library or command-line parser (Embree, TBB, tinygltf,
-#     Draco, cairo, CLI11), and that it does name liblumx (so the check looks at the real line);
+#     Draco, cairo, CLI11), and that it does name liblumx (so the check looks at the real line) and
+#     libxml2 (the static core's private TM-33 dependency, found through lumx-core.cmake);
 #  3. builds tests/consumer/bake (COMPONENTS bake) and runs it;
 #  4. asks for an unknown component and for each component this installation lacks: configuring must
 #     fail with a message naming it.
@@ -41,6 +42,11 @@ file(READ ${WORK_DIR}/core/CMakeFiles/consumer.dir/link.txt link_line)
 string(TOLOWER "${link_line}" link_lower)
 if(NOT link_lower MATCHES "liblumx")
   message(FATAL_ERROR "the core consumer's link line does not name liblumx:\n${link_line}")
+endif()
+# liblumx is static: its private dependencies (libxml2 for TM-33 among them) reach the consumer through
+# find_dependency in lumx-core.cmake, which must name them.
+if(NOT link_lower MATCHES "xml2")
+  message(FATAL_ERROR "the core consumer's link line does not name libxml2 (lumx-core.cmake find_dependency):\n${link_line}")
 endif()
 if(link_lower MATCHES "(${forbidden})")
   message(FATAL_ERROR "the core consumer links '${CMAKE_MATCH_1}':\n${link_line}")

@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// libFuzzer target: any bytes through both readers, validation, the intensity table and both writers.
+// libFuzzer target: any bytes through the IES, EULUMDAT and TM-33 (XML and JSON) readers, validation, the
+// intensity table and the writers.
 // Only lumx::Error may come out of a reader; a table that was read must survive everything after it.
 //
 //   bash scripts/fuzz.sh photometry 300
 #include <lumx/photometry/intensity_table.h>
 #include <lumx/io/photometry_io.h>
+#include <lumx/io/tm33_io.h>
 #include <lumx/photometry/metrics.h>
 #include <lumx/photometry/validate.h>
 
@@ -29,6 +31,8 @@ void exercise(const lumx::Photometry& p) {
   try {
     (void)lumx::read_ies(lumx::format_ies(p), "rt.ies");
     if (p.type == lumx::PhotometricType::C) (void)lumx::read_ldt(lumx::format_ldt(p), "rt.ldt");
+    (void)lumx::read_tm33_xml(lumx::format_tm33_xml(p), "rt.xml");
+    (void)lumx::read_tm33_json(lumx::format_tm33_json(p), "rt.json");
   } catch (const lumx::Error&) {
   }
 }
@@ -39,9 +43,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   lumx::ReadOptions o;
   o.warnings = [](const lumx::Diagnostic&) {};
-  for (int format = 0; format < 2; ++format) {
+  for (int format = 0; format < 4; ++format) {
     try {
-      const lumx::Photometry p = format == 0 ? lumx::read_ies(text, "fuzz.ies", o) : lumx::read_ldt(text, "fuzz.ldt", o);
+      const lumx::Photometry p = format == 0   ? lumx::read_ies(text, "fuzz.ies", o)
+                                 : format == 1 ? lumx::read_ldt(text, "fuzz.ldt", o)
+                                 : format == 2 ? lumx::read_tm33_xml(text, "fuzz.xml", o)
+                                               : lumx::read_tm33_json(text, "fuzz.json", o);
       exercise(p);
     } catch (const lumx::Error&) {
     }

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// lumx/io/photometry_io.h — reading and writing IES LM-63 and EULUMDAT files.
+// lumx/io/photometry_io.h — reading and writing IES LM-63, EULUMDAT and IES TM-33 files.
 //
 // The format layer on top of the model in lumx/photometry/photometry.h. Each format has a reader and a writer
-// (src/io/photometry/ies_reader.cpp, ies_writer.cpp, ldt_reader.cpp, ldt_writer.cpp); read_photometry() picks one by
+// (src/io/photometry/ies_reader.cpp, ies_writer.cpp, ldt_reader.cpp, ldt_writer.cpp; TM-33 in lumx/io/tm33_io.h
+// and tm33_reader.cpp, tm33_writer.cpp); read_photometry() picks one by
 // file extension and falls back to sniffing the content. Readers are permissive about what real files do
 // (formats.md §1.6, §2.4) and report it as warnings; they throw lumx::Error, located by file, line and
 // field, for anything that would make the data wrong. Untrusted counts are checked against the values
@@ -20,7 +21,8 @@
 
 LUMX_NAMESPACE_BEGIN
 
-enum class PhotometryFormat { ies, ldt };
+/// File formats of far-field photometry. TM-33 (= ATLA S001 = UNI 11733) is XML, or its JSON form.
+enum class PhotometryFormat { ies, ldt, tm33_xml, tm33_json };
 
 /// Limits that protect readers from absurd or hostile files. A file exceeding one is rejected.
 struct ReadLimits {
@@ -42,12 +44,13 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
 /// Parses EULUMDAT text. `name` is used in diagnostics.
 Photometry read_ldt(std::string_view text, const std::string& name, const ReadOptions& options = {});
 
-/// Format named by a file name's extension (.ies, .ldt, case-insensitive), if any.
+/// Format named by a file name's extension (.ies, .ldt, .xml and .json for TM-33; case-insensitive), if any.
 std::optional<PhotometryFormat> format_from_extension(const std::string& path);
 
-/// Format from a file name's extension (.ies, .ldt, case-insensitive), else by sniffing `head` (the
-/// file's first bytes): an IES version line or a TILT= line means IES, otherwise EULUMDAT if the first
-/// lines have its numeric layout. Throws lumx::Error if neither fits.
+/// Format from a file name's extension (see format_from_extension), else by sniffing `head` (the
+/// file's first bytes): '<' or '{' first means TM-33 XML or JSON, an IES version line or a TILT= line
+/// means IES, otherwise EULUMDAT if the first lines have its numeric layout. Throws lumx::Error if none
+/// fits.
 PhotometryFormat detect_format(const std::string& path, std::string_view head);
 
 /// Reads a file of either format. Throws lumx::Error (file missing, too large, or malformed).
@@ -79,9 +82,23 @@ std::string format_ies(const Photometry& p, const IesWriteOptions& options = {})
 /// EULUMDAT text for `p`. Type C only (convert A/B with to_type_c first); intensities written in cd/klm.
 std::string format_ldt(const Photometry& p, const LdtWriteOptions& options = {});
 
+/// Editions of IES TM-33 the TM-33 writer can produce (docs/tm33.md).
+enum class Tm33Version {
+  tm33_23,  ///< root "IESTM33-22", Version 1.1: adds Symm and Multiplier (default)
+  tm33_18,  ///< root "IESTM33", Version 1.0: TM-33-18, ATLA S001, UNI 11733
+};
+
+struct Tm33WriteOptions {
+  Tm33Version version = Tm33Version::tm33_23;
+  /// Significant digits of numbers; 0 writes the shortest text that reads back to the same double, so
+  /// TM-33 -> model -> TM-33 keeps every value exactly.
+  int significant_digits = 0;
+};
+
 struct WriteOptions {
   IesWriteOptions ies;
   LdtWriteOptions ldt;
+  Tm33WriteOptions tm33;
 };
 
 /// Writes `p` in the format named by `path`'s extension, atomically (temporary file in the same folder,

@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 LUMX_NAMESPACE_BEGIN
@@ -132,10 +133,37 @@ struct LdtHeader {
   std::vector<double> direct_ratios;  ///< line 27, 10 values for k = 0.6 ... 5 (empty if unknown)
 };
 
+/// An element of a structured file (XML, or its JSON form) kept as data because the model has no field
+/// for it: TM-33 spectral and colour blocks, equipment, custom data. Name, attributes and text as read,
+/// children in file order. A writer of the same format puts it back where it was.
+struct DataElement {
+  std::string name;
+  std::vector<std::pair<std::string, std::string>> attributes;
+  std::string text;
+  std::vector<DataElement> children;
+};
+
+/// An element kept as data, with the path of the element it belonged to ("Header", "Luminaire",
+/// "Equipment", "Emitter[0]", "Emitter[0]/LuminousData", "" for the root).
+struct KeptElement {
+  std::string parent;
+  DataElement element;
+};
+
+/// IES TM-33 / ATLA S001 fields with no IES or EULUMDAT counterpart, kept so that TM-33 -> model -> TM-33
+/// round-trips (docs/tm33.md).
+struct Tm33Header {
+  std::string version;          ///< "Version" as read: "1.0" (TM-33-18 / S001) or "1.1" (TM-33-23)
+  std::string root;             ///< root element read: "IESTM33", "IESTM33-22" or "LuminaireOpticalData"
+  std::string goniometer_type;  ///< Equipment/Gonioradiometer/Type as read ("CIE_C", "IES_B", ...)
+  double luminous_flux_lm = 0;  ///< LuminousData/LuminousFlux as stated by the file, lm (0 = absent)
+  std::vector<KeptElement> kept;  ///< elements with no place in the model, in file order
+};
+
 /// Where the data came from; line numbers locate validation findings in the source.
 struct SourceInfo {
   std::string file;                 ///< path or name given to the reader
-  std::string format;               ///< "IES" or "EULUMDAT"
+  std::string format;               ///< "IES", "EULUMDAT" or "TM-33"
   std::string version;              ///< e.g. "LM-63-2002"
   std::vector<std::uint32_t> horizontal_lines;  ///< line of each stored horizontal angle (may be empty)
   std::vector<std::uint32_t> vertical_lines;    ///< line of each stored vertical angle
@@ -164,6 +192,7 @@ struct Photometry {
   std::vector<Keyword> keywords;       ///< IES keywords in file order
   std::optional<TiltTable> tilt;       ///< TILT data, if the file had any
   LdtHeader ldt;                       ///< EULUMDAT-only fields
+  Tm33Header tm33;                     ///< TM-33-only fields and kept blocks
   SourceInfo source;
 
   std::size_t num_horizontal() const { return horizontal_deg.size(); }

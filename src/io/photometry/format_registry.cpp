@@ -3,6 +3,7 @@
 // Chooses a reader or writer by file extension, falling back to sniffing the content.
 #include <lumx/io/atomic_file.h>
 #include <lumx/io/photometry_io.h>
+#include <lumx/io/tm33_io.h>
 
 #include "io/text_scanner.h"
 
@@ -42,24 +43,37 @@ bool looks_like_ldt(std::string_view head) {
   return true;
 }
 
+/// TM-33: XML or its JSON form; the first non-blank byte (after a UTF-8 BOM) tells which.
+std::optional<PhotometryFormat> looks_like_tm33(std::string_view head) {
+  if (head.substr(0, 3) == "\xEF\xBB\xBF") head.remove_prefix(3);
+  const std::size_t i = head.find_first_not_of(" \t\r\n");
+  if (i == std::string_view::npos) return std::nullopt;
+  if (head[i] == '<') return PhotometryFormat::tm33_xml;
+  if (head[i] == '{') return PhotometryFormat::tm33_json;
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<PhotometryFormat> format_from_extension(const std::string& path) {
   const std::string ext = lower_extension(path);
   if (ext == ".ies") return PhotometryFormat::ies;
   if (ext == ".ldt") return PhotometryFormat::ldt;
+  if (ext == ".xml") return PhotometryFormat::tm33_xml;
+  if (ext == ".json") return PhotometryFormat::tm33_json;
   return std::nullopt;
 }
 
 PhotometryFormat detect_format(const std::string& path, std::string_view head) {
   if (const auto f = format_from_extension(path)) return *f;
+  if (const auto f = looks_like_tm33(head)) return *f;
   if (looks_like_ies(head)) return PhotometryFormat::ies;
   if (looks_like_ldt(head)) return PhotometryFormat::ldt;
   Diagnostic d;
   d.file = path;
   d.line = 1;
   d.field = "format";
-  d.message = "neither IES LM-63 (no version or TILT= line) nor EULUMDAT (lines 2-7 are not numbers)";
+  d.message = "neither TM-33 (XML or JSON), IES LM-63 (no version or TILT= line) nor EULUMDAT (lines 2-7 are not numbers)";
   throw Error(std::move(d));
 }
 
@@ -70,7 +84,13 @@ Photometry read_photometry(const std::string& path, const ReadOptions& options) 
     const auto parent = std::filesystem::path(path).parent_path();
     opts.base_dir = parent.empty() ? "." : parent.string();
   }
-  return detect_format(path, text) == PhotometryFormat::ies ? read_ies(text, path, opts) : read_ldt(text, path, opts);
+  switch (detect_format(path, text)) {
+    case PhotometryFormat::ies: return read_ies(text, path, opts);
+    case PhotometryFormat::ldt: return read_ldt(text, path, opts);
+    case PhotometryFormat::tm33_xml: return read_tm33_xml(text, path, opts);
+    case PhotometryFormat::tm33_json: return read_tm33_json(text, path, opts);
+  }
+  return read_ldt(text, path, opts);
 }
 
 void write_photometry(const Photometry& p, const std::string& path, const WriteOptions& options) {
@@ -79,10 +99,16 @@ void write_photometry(const Photometry& p, const std::string& path, const WriteO
     Diagnostic d;
     d.file = path;
     d.field = "output format";
-    d.message = "unknown extension '" + lower_extension(path) + "' (expected .ies or .ldt)";
+    d.message = "unknown extension '" + lower_extension(path) + "' (expected .ies, .ldt, or .xml / .json for TM-33)";
     throw Error(std::move(d));
   }
-  const std::string text = *format == PhotometryFormat::ies ? format_ies(p, options.ies) : format_ldt(p, options.ldt);
+  std::string text;
+  switch (*format) {
+    case PhotometryFormat::ies: text = format_ies(p, options.ies); break;
+    case PhotometryFormat::ldt: text = format_ldt(p, options.ldt); break;
+    case PhotometryFormat::tm33_xml: text = format_tm33_xml(p, options.tm33); break;
+    case PhotometryFormat::tm33_json: text = format_tm33_json(p, options.tm33); break;
+  }
   write_file_atomically(path, text);
 }
 

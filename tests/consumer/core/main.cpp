@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// What a plugin does with the core component alone: read an IES file, ship it as a one-APL bundle, open
-// the bundle reading its manifest only, load the level at a reduced resolution, and query irradiance.
+// What a plugin does with the core component alone: read an IES file, write it as TM-33 XML and read that
+// back (libxml2, a private dependency of the core), ship it as a one-APL bundle, open the bundle reading
+// its manifest only, load the level at a reduced resolution, and query irradiance.
 //
 //   consumer FILE.ies SCRATCH_DIR      exit 0 when every check holds, 1 otherwise
 //
-// Checks: the bundle keeps the file's flux (0.5 %), and irradiance 3 m below the luminaire on a floor
+// Checks: the TM-33 copy has the same candela table (exactly: shortest round-trip numbers), the bundle
+// keeps the file's flux (0.5 %), and irradiance 3 m below the luminaire on a floor
 // facing up equals the inverse-square law E = I(nadir) / d² from the file's own table within 2 %. The
 // loaded maps are 32 × 32 per hemisphere (box-filtered), so at nadir the lookup averages the four texels
 // that meet there, each a square of side a = sqrt(2π)/32 rad ≈ 4.5° with a corner at nadir, over which
@@ -14,6 +16,7 @@
 #include <lumx/apl/far_field.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
+#include <lumx/io/tm33_io.h>
 #include <lumx/photometry/intensity_table.h>
 #include <lumx/photometry/metrics.h>
 #include <lumx/version.h>
@@ -30,6 +33,12 @@ int main(int argc, char** argv) {
   }
   try {
     const lumx::Photometry p = lumx::read_photometry(argv[1]);
+    const std::string tm33 = std::string(argv[2]) + "/consumer.xml";
+    lumx::write_photometry(p, tm33);
+    if (lumx::read_photometry(tm33).candela != p.candela) {
+      std::fprintf(stderr, "the TM-33 copy %s has a different candela table\n", tm33.c_str());
+      return 1;
+    }
     const lumx::PhotometricSummary s = lumx::summarize(p);
     const lumx::IntensityTable table(p);
     const std::string bundle = std::string(argv[2]) + "/consumer.lumx";

@@ -1,0 +1,199 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// GLDF containers: every shared container listed, checked against the GLDF XSD and its photometry read;
+// hostile archives (path traversal, zip bombs, oversized entries) refused before extraction; findings
+// located as container.gldf!/entry:line.
+#include <lumx/io/gldf_io.h>
+#include <lumx/photometry/intensity_table.h>
+
+#include <gtest/gtest.h>
+#include <zip.h>
+
+#include "test_support.h"
+
+#include <algorithm>
+#include <filesystem>
+
+using namespace lumx;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path gldf_dir() {
+  const auto root = lumx_test::shared_dir();
+  return root.empty() ? fs::path() : root / "data" / "gldf";
+}
+
+std::vector<fs::path> shared_containers() {
+  std::vector<fs::path> out;
+  if (gldf_dir().empty() || !fs::exists(gldf_dir() / "containers")) return out;
+  for (const auto& e : fs::directory_iterator(gldf_dir() / "containers"))
+    if (e.path().extension() == ".gldf") out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// Writes a ZIP with the given entries (name, bytes), deflated.
+void write_zip(const fs::path& path, const std::vector<std::pair<std::string, std::string>>& entries) {
+  fs::remove(path);
+  int err = 0;
+  zip_t* z = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &err);
+  ASSERT_NE(z, nullptr);
+  for (const auto& [name, bytes] : entries) {
+    zip_source_t* s = zip_source_buffer(z, bytes.data(), bytes.size(), 0);
+    ASSERT_NE(s, nullptr);
+    ASSERT_GE(zip_file_add(z, name.c_str(), s, ZIP_FL_ENC_UTF_8), 0) << name;
+  }
+  ASSERT_EQ(zip_close(z), 0);
+}
+
+const char* kProduct = R"(<?xml version="1.0" encoding="UTF-8"?>
+<Root>
+  <Header>
+    <Manufacturer>lumx tests</Manufacturer>
+    <FormatVersion major="1" minor="0" pre-release="3" />
+  </Header>
+  <GeneralDefinitions>
+    <Files>
+      <File id="f1" contentType="ldc/eulumdat" type="localFileName">a.ldt</File>
+    </Files>
+    <Photometries>
+      <Photometry id="p1"><PhotometryFileReference fileId="f1" /></Photometry>
+    </Photometries>
+    <Emitters>
+      <Emitter id="e1"><FixedLightEmitter><PhotometryReference photometryId="p1" /></FixedLightEmitter></Emitter>
+    </Emitters>
+  </GeneralDefinitions>
+  <ProductDefinitions>
+    <ProductMetaData><Name><Locale language="en">Test</Locale></Name></ProductMetaData>
+    <Variants>
+      <Variant id="v1"><Geometry><EmitterReference emitterId="e1" /></Geometry></Variant>
+    </Variants>
+  </ProductDefinitions>
+</Root>
+)";
+
+std::string fixture_ldt() { return lumx_test::read_text(lumx_test::data_dir() / "ldt" / "isym2_point.ldt"); }
+
+Diagnostic error_of(const fs::path& p, const GldfReadOptions& o = {}) {
+  try {
+    (void)read_gldf(p.string(), o);
+  } catch (const Error& e) {
+    return e.diagnostic();
+  }
+  ADD_FAILURE() << "no error for " << p;
+  return {};
+}
+
+}  // namespace
+
+TEST(Gldf, EverySharedContainerIsListedCheckedAndItsPhotometryRead) {
+  const auto containers = shared_containers();
+  if (containers.empty()) LUMX_SKIP_WITHOUT_SHARED("data/gldf/containers");
+  const std::string xsd = (gldf_dir() / "xsd" / "gldf.xsd").string();
+  std::size_t photometry_files = 0;
+  for (const auto& path : containers) {
+    SCOPED_TRACE(path.string());
+    const GldfContainer c = read_gldf(path.string());
+    EXPECT_FALSE(c.product_name.empty());
+    EXPECT_FALSE(c.variants.empty());
+    EXPECT_FALSE(c.emitters.empty());
+    for (const auto& f : c.files) {
+      if (f.content_type.rfind("ldc/", 0) != 0) continue;
+      ASSERT_FALSE(f.entry.empty()) << f.name;
+      const Photometry p = read_gldf_photometry(c, f);
+      EXPECT_GT(IntensityTable(p).flux_lm(), 0) << f.entry;
+      EXPECT_EQ(p.source.file, path.string() + "!/" + f.entry);
+      ++photometry_files;
+    }
+    // check: passes, or fails with findings located inside the container.
+    for (const auto& d : check_gldf(path.string(), xsd)) {
+      EXPECT_EQ(d.file.rfind(path.string() + "!/", 0), 0u) << d.str();
+      if (d.severity == Severity::error) {
+        EXPECT_GT(d.line, 0) << d.str();
+      }
+      if (d.field == "XSD") {
+        EXPECT_EQ(d.file, path.string() + "!/product.xml") << d.str();
+      }
+    }
+  }
+  EXPECT_GE(photometry_files, 9u);  // 6 containers: 1 + 1 + 1 + 3 + 2 + 1 files
+}
+
+TEST(Gldf, ListsProductsVariantsEmittersAndTheirPhotometry) {
+  if (shared_containers().empty()) LUMX_SKIP_WITHOUT_SHARED("data/gldf/containers");
+  const GldfContainer c = read_gldf((gldf_dir() / "containers" / "SLV_-_Tria_2.gldf").string());
+  EXPECT_EQ(c.manufacturer, "SLV");
+  EXPECT_EQ(c.format_version, "1.0-rc.3");
+  EXPECT_EQ(c.product_name, "NEW TRIA 2");
+  EXPECT_EQ(c.product_number, "111352");
+  EXPECT_EQ(c.photometries.size(), 3u);
+  ASSERT_GE(c.emitters.size(), 5u);
+  EXPECT_EQ(c.emitters[0].id, "em-n-n");
+  EXPECT_EQ(c.emitters[0].photometry_ids, std::vector<std::string>{"LightEmitterNarrow"});
+  ASSERT_GE(c.variants.size(), 2u);
+  EXPECT_EQ(c.variants[0].emitter_ids, (std::vector<std::string>{"em-n-n", "em-w-c"}));
+  EXPECT_EQ(c.variants[0].geometry_id, "ModelGeometry");
+  const auto l3d = std::find_if(c.files.begin(), c.files.end(), [](const GldfFile& f) { return f.content_type == "geo/l3d"; });
+  ASSERT_NE(l3d, c.files.end());
+  EXPECT_EQ(l3d->entry, "geo/example_007.l3d");
+  EXPECT_TRUE(c.findings.empty());
+}
+
+TEST(Gldf, XsdViolationsAndBadPhotometryAreLocatedInsideTheContainer) {
+  if (shared_containers().empty()) LUMX_SKIP_WITHOUT_SHARED("data/gldf/xsd");
+  const std::string xsd = (gldf_dir() / "xsd" / "gldf.xsd").string();
+  const fs::path p = lumx_test::unique_temp_path("gldf_bad.gldf");
+  std::string ldt = fixture_ldt();
+  ldt = ldt.substr(0, ldt.size() / 2);  // truncated photometry
+  std::string product = kProduct;
+  product.replace(product.find("<Manufacturer>"), 0, "<Bogus/>\n    ");  // not in the schema (line 4)
+  write_zip(p, {{"product.xml", product}, {"ldc/a.ldt", ldt}});
+  const auto findings = check_gldf(p.string(), xsd);
+  bool xsd_found = false, ldt_found = false;
+  for (const auto& d : findings) {
+    if (d.field == "XSD" && d.file == p.string() + "!/product.xml" && d.line == 4) xsd_found = true;
+    if (d.file == p.string() + "!/ldc/a.ldt" && d.line > 0 && d.severity == Severity::error) ldt_found = true;
+  }
+  EXPECT_TRUE(xsd_found);
+  EXPECT_TRUE(ldt_found);
+  // A dangling reference is a finding at its line of product.xml.
+  std::string dangling = kProduct;
+  dangling.replace(dangling.find("photometryId=\"p1\""), 17, "photometryId=\"p9\"");
+  write_zip(p, {{"product.xml", dangling}, {"ldc/a.ldt", fixture_ldt()}});
+  const GldfContainer c = read_gldf(p.string());
+  ASSERT_EQ(c.findings.size(), 1u);
+  EXPECT_EQ(c.findings[0].field, "PhotometryReference");
+  EXPECT_EQ(c.findings[0].line, 15);
+  fs::remove(p);
+}
+
+TEST(Gldf, HostileArchivesAreRefusedBeforeExtraction) {
+  const fs::path p = lumx_test::unique_temp_path("gldf_hostile.gldf");
+  const std::string ldt = fixture_ldt();
+  for (const char* name : {"../evil.ldt", "ldc/../../evil.ldt", "/etc/evil.ldt", "ldc\\evil.ldt", "C:/evil.ldt"}) {
+    write_zip(p, {{"product.xml", kProduct}, {name, ldt}});
+    const Diagnostic d = error_of(p);
+    EXPECT_EQ(d.field, "entry name") << name << ": " << d.str();
+    EXPECT_NE(d.file.find(std::string("!/") + name), std::string::npos) << d.str();
+  }
+  // A zip bomb: 4 MiB of zeros deflate to a few KiB.
+  write_zip(p, {{"product.xml", kProduct}, {"ldc/a.ldt", std::string(4u << 20, '\0')}});
+  EXPECT_EQ(error_of(p).field, "compression ratio");
+  // Entries larger than the limits.
+  GldfReadOptions small;
+  small.limits.max_entry_bytes = 300;  // the LDT is 359 bytes
+  write_zip(p, {{"product.xml", std::string(200, ' ') + "<Root/>"}, {"ldc/a.ldt", ldt}});
+  const Diagnostic big = error_of(p, small);
+  EXPECT_EQ(big.field, "entry size");
+  EXPECT_EQ(big.file, p.string() + "!/ldc/a.ldt");
+  small = {};
+  small.limits.max_entries = 1;
+  EXPECT_NE(error_of(p, small).message.find("entries exceed"), std::string::npos);
+  // Not a ZIP; no product.xml.
+  std::ofstream(p, std::ios::binary | std::ios::trunc) << "PK\x03\x04 not really";
+  EXPECT_EQ(error_of(p).field, "ZIP");
+  write_zip(p, {{"ldc/a.ldt", ldt}});
+  EXPECT_EQ(error_of(p).field, "product.xml");
+  fs::remove(p);
+}
