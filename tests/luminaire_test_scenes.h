@@ -5,12 +5,14 @@
 // perfect mirror, smooth glass).
 #pragma once
 
+#include <lumx/bake/gltf_writer.h>
 #include <lumx/bake/luminaire_builder.h>
 #include <lumx/math/constants.h>
 
 #include <glm/geometric.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -143,6 +145,29 @@ inline double triangle_solid_angle(const glm::dvec3& a, const glm::dvec3& b, con
   const double numerator = glm::dot(a, glm::cross(b, c));
   const double denominator = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
   return std::abs(2.0 * std::atan2(numerator, denominator));
+}
+
+/// A Lambertian emissive disk (L = 1000 cd/m², r = 5 cm, 64 segments) written as dir/disk.glb: every particle
+/// leaves at once.
+inline std::filesystem::path write_disk_luminaire(const std::filesystem::path& dir) {
+  SceneBuilder b("disk");
+  b.begin_part("disk", b.add_material(emissive(1000.0)));
+  add_disk(b, 0.05, 64);
+  const std::filesystem::path path = dir / "disk.glb";
+  lumx::bake::write_gltf_luminaire(b.scene(), path.string());
+  return path;
+}
+
+/// A point light inside a white Lambertian sphere (r = 10 cm) with a port of half-angle 0.5 rad, written as
+/// dir/sphere.glb: particles bounce (segments for the volume) and leave after a random number of bounces.
+inline std::filesystem::path write_sphere_luminaire(const std::filesystem::path& dir) {
+  SceneBuilder b("sphere");
+  b.begin_part("wall", b.add_material(lambertian(0.8)));
+  add_sphere(b, 0.1, 16, 32, 0.5, false);
+  b.point_light({0.01, 0.0, 0.0}, 1.0);
+  const std::filesystem::path path = dir / "sphere.glb";
+  lumx::bake::write_gltf_luminaire(b.scene(), path.string());
+  return path;
 }
 
 }  // namespace lumx_test

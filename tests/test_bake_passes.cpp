@@ -18,8 +18,6 @@
 #include <csignal>
 #include <filesystem>
 #include <functional>
-#include <fstream>
-#include <iterator>
 #include <thread>
 
 #include <fcntl.h>
@@ -31,39 +29,7 @@ namespace {
 using namespace lumx_test;
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  const fs::path p = lumx_test::unique_temp_path("lumx_bake_passes_" + name);
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
-
-std::string bytes_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-/// A point light inside a white sphere with a 30° port: particles bounce (segments for the volume) and
-/// leave through the port after a random number of bounces.
-fs::path sphere_luminaire(const fs::path& dir) {
-  SceneBuilder b("sphere");
-  b.begin_part("wall", b.add_material(lambertian(0.8)));
-  add_sphere(b, 0.1, 16, 32, 0.5, false);
-  b.point_light({0.01, 0.0, 0.0}, 1.0);
-  const fs::path path = dir / "sphere.glb";
-  lumx::bake::write_gltf_luminaire(b.scene(), path.string());
-  return path;
-}
-
-/// A Lambertian emissive disk (L = 1000 cd/m², r = 5 cm).
-fs::path disk_luminaire(const fs::path& dir) {
-  SceneBuilder b("disk");
-  b.begin_part("disk", b.add_material(emissive(1000.0)));
-  add_disk(b, 0.05, 64);
-  const fs::path path = dir / "disk.glb";
-  lumx::bake::write_gltf_luminaire(b.scene(), path.string());
-  return path;
-}
+fs::path scratch(const std::string& name) { return lumx_test::fresh_temp_dir("lumx_bake_passes_" + name); }
 
 lumx::bake::BakeOptions small_bake(std::uint64_t particles) {
   lumx::bake::BakeOptions o;
@@ -82,7 +48,7 @@ std::string attachment_sha(const lumx::BundleReader& b, const std::string& name)
 
 TEST(BakePasses, SameBundleForAnyPassSizeAndThreadCount) {
   const fs::path dir = scratch("determinism");
-  const fs::path glb = sphere_luminaire(dir);
+  const fs::path glb = write_sphere_luminaire(dir);
   struct Variant {
     std::uint64_t pass;
     int threads;
@@ -104,7 +70,7 @@ TEST(BakePasses, SameBundleForAnyPassSizeAndThreadCount) {
   ASSERT_TRUE(first.manifest().volume.has_value());
   for (std::size_t v = 1; v < variants.size(); ++v) {
     const lumx::BundleReader other((dir / ("b" + std::to_string(v))).string());
-    EXPECT_EQ(bytes_of(dir / "r0.tm25ray"), bytes_of(dir / ("r" + std::to_string(v) + ".tm25ray"))) << v;
+    EXPECT_EQ(read_text(dir / "r0.tm25ray"), read_text(dir / ("r" + std::to_string(v) + ".tm25ray"))) << v;
     ASSERT_EQ(first.manifest().levels.size(), other.manifest().levels.size());
     for (std::size_t k = 0; k < first.manifest().levels.size(); ++k)
       EXPECT_EQ(first.manifest().levels[k].maps.at(0).sha256, other.manifest().levels[k].maps.at(0).sha256) << v;
@@ -120,7 +86,7 @@ TEST(BakePasses, SameBundleForAnyPassSizeAndThreadCount) {
 
 TEST(BakePasses, StopsAsSoonAsTheHeldOutErrorIsBelowTheTarget) {
   const fs::path dir = scratch("target");
-  const fs::path glb = disk_luminaire(dir);
+  const fs::path glb = write_disk_luminaire(dir);
   std::vector<lumx::bake::BakeProgress> seen;
   lumx::bake::BakeOptions o = small_bake(4000000);
   o.target_error = 0.5;  // 50 % at d = 2: reached by the first pass of 2^18 particles
@@ -175,7 +141,7 @@ TEST(BakePasses, StopsAsSoonAsTheHeldOutErrorIsBelowTheTarget) {
 
 TEST(BakePasses, TimeLimitEndsTheBakeBeforeTheBudget) {
   const fs::path dir = scratch("time");
-  const fs::path glb = sphere_luminaire(dir);
+  const fs::path glb = write_sphere_luminaire(dir);
   lumx::bake::BakeOptions o = small_bake(std::uint64_t(1) << 34);  // far more than 0.5 s can trace
   o.pass_particles = 8192;
   o.time_limit_seconds = 0.5;
@@ -191,7 +157,7 @@ TEST(BakePasses, TimeLimitEndsTheBakeBeforeTheBudget) {
 
 TEST(BakePasses, BadOptionsAreNamed) {
   const fs::path dir = scratch("options");
-  const fs::path glb = disk_luminaire(dir);
+  const fs::path glb = write_disk_luminaire(dir);
   lumx::bake::BakeOptions o = small_bake(0);
   try {
     lumx::bake::bake_luminaire(glb.string(), (dir / "b").string(), o);
@@ -244,12 +210,12 @@ bool has_entry_containing(const fs::path& dir, const std::string& part) {
 TEST(BakePasses, KilledBakeLeavesThePreviousBundleAndNoScratchAfterTheNextRun) {
   if (std::string(LUMX_CLI_PATH).empty()) GTEST_SKIP() << "built without the CLI";
   const fs::path dir = scratch("kill");
-  const fs::path glb = sphere_luminaire(dir);
+  const fs::path glb = write_sphere_luminaire(dir);
   const std::string out = (dir / "b").string();
   const std::vector<std::string> small = {"bake", glb.string(), out, "--particles", "20000", "--levels", "1", "8",
                                           "--no-eval", "--volume-voxels", "4096"};
   ASSERT_FALSE(bake_and_kill(small, [] { return false; }));
-  const std::string manifest = bytes_of(dir / "b" / "manifest.json");
+  const std::string manifest = read_text(dir / "b" / "manifest.json");
   ASSERT_FALSE(manifest.empty());
 
   // Killed while tracing (its scratch file of exits exists), then while writing the new bundle (its
@@ -262,7 +228,7 @@ TEST(BakePasses, KilledBakeLeavesThePreviousBundleAndNoScratchAfterTheNextRun) {
     killed_writing = bake_and_kill(big, [&] { return has_entry_containing(dir, ".b.tmp-"); });
   EXPECT_TRUE(killed_writing) << "the bake was never caught writing its bundle";
   EXPECT_TRUE(has_entry_containing(dir, ".tmp-"));  // what SIGKILL left behind
-  EXPECT_EQ(bytes_of(dir / "b" / "manifest.json"), manifest);
+  EXPECT_EQ(read_text(dir / "b" / "manifest.json"), manifest);
   EXPECT_TRUE(lumx::check_bundle(out).empty());  // every payload read, sizes and SHA-256 verified
 
   // The next bake of the same bundle removes the dead bakes' scratch files and temporaries.

@@ -15,38 +15,17 @@
 
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 namespace {
 
 using namespace lumx_test;
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  const fs::path p = lumx_test::unique_temp_path("lumx_cli_bake_" + name);
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
-
-std::string bytes_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-/// A Lambertian emissive disk (L = 1000 cd/m², r = 5 cm) written as .glb: every particle leaves at once.
-fs::path disk_luminaire(const fs::path& dir) {
-  SceneBuilder b("disk");
-  b.begin_part("disk", b.add_material(emissive(1000.0)));
-  add_disk(b, 0.05, 64);
-  const fs::path path = dir / "disk.glb";
-  lumx::bake::write_gltf_luminaire(b.scene(), path.string());
-  return path;
-}
+fs::path scratch(const std::string& name) { return lumx_test::fresh_temp_dir("lumx_cli_bake_" + name); }
 
 TEST(CliBake, DiskBundleCarriesPiLAExactly) {
   const fs::path dir = scratch("disk");
-  const fs::path glb = disk_luminaire(dir);
+  const fs::path glb = write_disk_luminaire(dir);
   const CliRun r = run_cli("bake " + quoted(glb) + " " + quoted(dir / "bundle") + " --particles 60000 --levels 1 8 " +
                            "--rays-out " + quoted(dir / "exits.tm25ray"));
   ASSERT_EQ(r.status, 0) << r.out;
@@ -82,14 +61,14 @@ TEST(CliBake, DiskBundleCarriesPiLAExactly) {
   EXPECT_TRUE(has_ies);
   for (std::size_t i = 0; i < m.attachments.size(); ++i)
     if (m.attachments[i].first.name == "luminaire.glb") {
-      EXPECT_EQ(bundle.read_attachment(i), bytes_of(glb));
+      EXPECT_EQ(bundle.read_attachment(i), read_text(glb));
     }
   fs::remove_all(dir);
 }
 
 TEST(CliBake, TargetErrorPassesAndPreview) {
   const fs::path dir = scratch("preview");
-  const fs::path glb = disk_luminaire(dir);
+  const fs::path glb = write_disk_luminaire(dir);
   const CliRun r = run_cli("bake " + quoted(glb) + " " + quoted(dir / "bundle") +
                            " --particles 600000 --levels 1 8 --target-error 0.0001 --target-distance 2 --preview " +
                            quoted(dir / "preview") + " --preview-resolution 32");
@@ -100,7 +79,7 @@ TEST(CliBake, TargetErrorPassesAndPreview) {
                         "polar_pass02.png", "convergence.txt"})
     EXPECT_TRUE(fs::exists(dir / "preview" / f)) << f;
   // One table row per pass, with the graded error of each.
-  const std::string table = bytes_of(dir / "preview" / "convergence.txt");
+  const std::string table = read_text(dir / "preview" / "convergence.txt");
   EXPECT_NE(table.find("\n   1      262144"), std::string::npos) << table;
   EXPECT_NE(table.find("\n   2  "), std::string::npos) << table;
   fs::remove_all(dir);
@@ -108,19 +87,14 @@ TEST(CliBake, TargetErrorPassesAndPreview) {
 
 TEST(CliBake, SameRaysAndMapsForOneAndTwoThreads) {
   const fs::path dir = scratch("threads");
-  SceneBuilder b("sphere");
-  b.begin_part("wall", b.add_material(lambertian(0.8)));
-  add_sphere(b, 0.1, 16, 32, 0.5, false);
-  b.point_light({0.01, 0.0, 0.0}, 1.0);
-  const fs::path glb = dir / "sphere.glb";
-  lumx::bake::write_gltf_luminaire(b.scene(), glb.string());
+  const fs::path glb = write_sphere_luminaire(dir);
   for (const char* t : {"1", "2"}) {
     const CliRun r = run_cli("bake " + quoted(glb) + " " + quoted(dir / (std::string("b") + t)) +
                              " --particles 20000 --levels 1 8 --no-eval --threads " + t + " --rays-out " +
                              quoted(dir / (std::string("r") + t + ".tm25ray")));
     ASSERT_EQ(r.status, 0) << r.out;
   }
-  EXPECT_EQ(bytes_of(dir / "r1.tm25ray"), bytes_of(dir / "r2.tm25ray"));
+  EXPECT_EQ(read_text(dir / "r1.tm25ray"), read_text(dir / "r2.tm25ray"));
   const lumx::BundleReader one((dir / "b1").string()), two((dir / "b2").string());
   ASSERT_EQ(one.manifest().levels.size(), two.manifest().levels.size());
   for (std::size_t k = 0; k < one.manifest().levels.size(); ++k)

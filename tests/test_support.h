@@ -24,6 +24,14 @@ inline std::filesystem::path unique_temp_path(const std::string& name) {
          (n.stem().string() + "_" + std::to_string(::getpid()) + n.extension().string());
 }
 
+/// unique_temp_path(name) as an empty folder (whatever a previous run left there is removed).
+inline std::filesystem::path fresh_temp_dir(const std::string& name) {
+  const std::filesystem::path p = unique_temp_path(name);
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p;
+}
+
 /// tests/data in the source tree: only files lumx made itself (bad-input corpus, synthetic fixtures).
 inline std::filesystem::path data_dir() { return LUMX_TEST_DATA_DIR; }
 

@@ -135,6 +135,8 @@ class Photometry:
     def polar_curve(self, plane: str = "C0-C180", step_deg: float = 0.5) -> Tuple[FloatArray, FloatArray]:
         """(theta_deg from -180 to 180, cd) in the plane 'C0-C180' or 'C90-C270'."""
     def summary(self) -> Summary: ...
+    def ugr_table(self, *, spacing_to_height: float = 0.25, height_m: float = 2.0) -> dict[str, object]:
+        """The CIE 117/190 UGR table: 'crosswise' and 'endwise' (19 × 5 arrays), rooms, reflectances, flux."""
     def validate(self) -> list[Finding]: ...
     def write(self, path: str, ies_version: int = 2019, digits: int = 7, expand_c90_c270: bool = False) -> None:
         """Writes .ies or .ldt (by extension), atomically."""

@@ -11,6 +11,7 @@
 #include <lumx/photometry/intensity_table.h>
 #include <lumx/photometry/metrics.h>
 #include <lumx/photometry/polar_diagram.h>
+#include <lumx/photometry/ugr.h>
 #include <lumx/photometry/validate.h>
 
 #include <cctype>
@@ -191,6 +192,49 @@ void bind_photometry(py::module_& m) {
           },
           "Datasheet figures: flux (lm), peak (cd), beam and field angles per plane (degrees), downward "
           "fraction, light output ratio, efficacy (lm/W) — the numbers `lumx info` prints.")
+      .def(
+          "ugr_table",
+          [](const lumx::Photometry& p, double spacing_to_height, double height_m) {
+            lumx::UgrTableOptions o;
+            o.spacing_to_height = spacing_to_height;
+            o.height_m = height_m;
+            lumx::UgrTable t;
+            {
+              const lumx::Photometry copy = p;
+              py::gil_scoped_release release;
+              t = lumx::ugr_table(copy, o);
+            }
+            const std::size_t rooms = o.rooms.size(), refl = o.reflectances.size();
+            py::array_t<double> cross({rooms, refl}), end({rooms, refl}), room_xy({rooms, std::size_t(2)}),
+                cwf({refl, std::size_t(3)});
+            for (std::size_t i = 0; i < rooms; ++i) {
+              room_xy.mutable_at(i, 0) = o.rooms[i].x_h;
+              room_xy.mutable_at(i, 1) = o.rooms[i].y_h;
+              for (std::size_t k = 0; k < refl; ++k) {
+                cross.mutable_at(i, k) = t.at(i, k, lumx::UgrView::crosswise);
+                end.mutable_at(i, k) = t.at(i, k, lumx::UgrView::endwise);
+              }
+            }
+            for (std::size_t k = 0; k < refl; ++k) {
+              cwf.mutable_at(k, 0) = o.reflectances[k].ceiling;
+              cwf.mutable_at(k, 1) = o.reflectances[k].walls;
+              cwf.mutable_at(k, 2) = o.reflectances[k].floor;
+            }
+            py::dict d;
+            d["crosswise"] = cross;
+            d["endwise"] = end;
+            d["rooms_xy_h"] = room_xy;
+            d["reflectances_cwf"] = cwf;
+            d["luminaire_flux_lm"] = t.luminaire_flux_lm;
+            return d;
+          },
+          py::kw_only(), py::arg("spacing_to_height") = 0.25, py::arg("height_m") = 2.0,
+          "The UGR table by the CIE 117/190 tabular method, as `lumx info --json` gives it: a dict of "
+          "'crosswise' and 'endwise' (19 rooms × 5 reflectances, NaN where no luminaire is in view), "
+          "'rooms_xy_h' (X, Y in multiples of H), 'reflectances_cwf' (ceiling, walls, floor) and "
+          "'luminaire_flux_lm'. spacing_to_height 0.25 is the catalogues' convention (CIE 190's own example "
+          "uses 1.0); height_m is H, the luminaire plane above the eye. Raises lumx.Error when the file gives "
+          "no luminous area.")
       .def(
           "validate", [](const lumx::Photometry& p) { return lumx::validate(p); },
           "Findings of strict validation (a list of lumx.Finding), located by the source lines when known.")
