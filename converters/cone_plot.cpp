@@ -47,12 +47,7 @@ PlotSummary write_cone_plot(const Photometry& p, const std::string& out, const M
       sum.labels.push_back(format_quantity(v));
   render_and_write(out, svg, W, H, [&](Painter& pt) {
     cairo_t* cr = pt.cr();
-    pt.color(kTextColor);
-    pt.fit_font(title, 0.032 * S, true, 0.94 * S);
-    pt.text_centered(title, 0.5 * S, 0.045 * S);
-    pt.color(kMutedColor);
-    pt.fit_font(caption, 0.021 * S, false, 0.94 * S);
-    pt.text_centered(caption, 0.5 * S, 0.09 * S);
+    pt.title_and_caption(title, caption, S, 0.045 * S, 0.09 * S);
     // The cone: apex at (ax, ay), depth to the largest distance over 0.66 S; the half width is true to
     // scale but clipped to the drawing's third.
     const double ax = 0.2 * S, ay = 0.16 * S, depth = 0.66 * S, k = depth / dmax;

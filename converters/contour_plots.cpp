@@ -147,12 +147,7 @@ void draw_legend(Painter& pt, const std::vector<double>& levels, const char* uni
 }
 
 void draw_header(Painter& pt, const std::string& title, const std::string& caption, double size) {
-  pt.color(kTextColor);
-  pt.fit_font(title, 0.032 * size, true, 0.94 * size);
-  pt.text_centered(title, 0.5 * size, 0.04 * size);
-  pt.color(kMutedColor);
-  pt.fit_font(caption, 0.021 * size, false, 0.94 * size);
-  pt.text_centered(caption, 0.5 * size, 0.08 * size);
+  pt.title_and_caption(title, caption, size, 0.04 * size, 0.08 * size);
   pt.check("title");
 }
 

@@ -88,6 +88,16 @@ void Painter::fit_font(const std::string& s, double size, bool bold, double max_
   if (w > max_width && w > 0) font(std::max(size * min_factor, size * max_width / w), bold);
 }
 
+void Painter::title_and_caption(const std::string& title, const std::string& caption, double width, double title_y,
+                                double caption_y) const {
+  color(kTextColor);
+  fit_font(title, 0.032 * width, true, 0.94 * width);
+  text_centered(title, 0.5 * width, title_y);
+  color(kMutedColor);
+  fit_font(caption, 0.021 * width, false, 0.94 * width);
+  text_centered(caption, 0.5 * width, caption_y);
+}
+
 void Painter::text_centered(const std::string& s, double x, double y) const {
   const cairo_text_extents_t e = extents(s);
   cairo_move_to(cr_, x - (e.x_bearing + e.width / 2), y - (e.y_bearing + e.height / 2));

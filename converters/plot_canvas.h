@@ -67,6 +67,11 @@ class Painter {
   /// Text whose ink box is centred on (x, y).
   void text_centered(const std::string& s, double x, double y) const;
 
+  /// A diagram's heading across an image `width` wide: the bold title centred at title_y, the muted caption
+  /// at caption_y, both shrunk to fit 94 % of the width.
+  void title_and_caption(const std::string& title, const std::string& caption, double width, double title_y,
+                         double caption_y) const;
+
   /// Text on baseline y: align 0 = left edge at x, 0.5 = centred, 1 = right edge at x.
   void text_baseline(const std::string& s, double x, double y, double align) const;
 

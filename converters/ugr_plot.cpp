@@ -56,12 +56,7 @@ PlotSummary write_ugr_plot(const Photometry& p, const std::string& out, const Me
   const std::string caption = cap;
   render_and_write(out, svg, W, H, [&](Painter& pt) {
     cairo_t* cr = pt.cr();
-    pt.color(kTextColor);
-    pt.fit_font(title, 0.032 * S, true, 0.94 * S);
-    pt.text_centered(title, 0.5 * S, 0.04 * S);
-    pt.color(kMutedColor);
-    pt.fit_font(caption, 0.021 * S, false, 0.94 * S);
-    pt.text_centered(caption, 0.5 * S, 0.078 * S);
+    pt.title_and_caption(title, caption, S, 0.04 * S, 0.078 * S);
     // Columns: X, Y, then 2 × nk values; a gap between the halves.
     const double left = 0.05 * S, col_xy = 0.065 * S, gap = 0.03 * S;
     const double col = (0.9 * S - 2 * col_xy - gap) / static_cast<double>(2 * nk);

@@ -3,8 +3,12 @@
 // Shared helpers for the test suite: where the test data lives.
 #pragma once
 
+#include <lumx/photometry/intensity_table.h>
+#include <lumx/photometry/photometric_frame.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -70,6 +74,19 @@ inline std::vector<std::filesystem::path> shared_photometry_files(const std::vec
 inline std::filesystem::path shared_photometry(const std::string& relative) {
   const auto root = shared_dir();
   return root.empty() ? std::filesystem::path() : root / "data" / "photometry" / relative;
+}
+
+/// Largest |I_a − I_b| (cd) over every stored direction of `a`'s expanded grid: what a conversion changed
+/// where `a` has data.
+inline double max_candela_difference(const lumx::Photometry& a, const lumx::Photometry& b) {
+  const lumx::IntensityTable ta(a), tb(b);
+  double worst = 0;
+  for (double h : ta.horizontal_deg())
+    for (double v : a.vertical_deg) {
+      const glm::dvec3 d = lumx::direction_from_angles(a.type, h, v);
+      worst = std::max(worst, std::abs(ta.intensity(d) - tb.intensity(d)));
+    }
+  return worst;
 }
 
 inline std::string read_text(const std::filesystem::path& p) {
