@@ -43,9 +43,13 @@
 
 #include <lumx/volume/radiance_volume.h>
 
+#include <lumx/render/camera.h>
+#include <lumx/render/image.h>
+
 #include <lumx/io/atomic_file.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/io/tm33_io.h>
 #include <lumx/io/gldf_io.h>
 #include <lumx/io/rayset_io.h>
+#include <lumx/io/image_io.h>

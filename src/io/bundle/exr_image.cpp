@@ -152,6 +152,25 @@ void ExrReader::read_rows(int y0, int y1, float* out) {
   }
 }
 
+ExrLayout probe_exr(std::string_view bytes, const std::string& file) {
+  try {
+    MemoryIStream stream(bytes, file);
+    Imf::InputFile input(stream);
+    const Imath::Box2i window = input.header().dataWindow();
+    if (window.min.x != 0 || window.min.y != 0) fail(file, "dataWindow", "does not start at (0, 0)");
+    ExrLayout layout;
+    layout.width = window.max.x + 1;
+    layout.height = window.max.y + 1;
+    for (auto it = input.header().channels().begin(); it != input.header().channels().end(); ++it)
+      layout.channels.emplace_back(it.name());
+    return layout;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(file, "OpenEXR", e.what());
+  }
+}
+
 ExrImage decode_exr(std::string_view bytes, const std::string& file, int width, int height,
                     const std::vector<std::string>& channels) {
   ExrReader reader(bytes, file, width, height, channels);

@@ -54,6 +54,16 @@ class ExrReader {
   bool half_ = true;
 };
 
+/// Size and channel names of an OpenEXR image in memory, from its header alone (nothing is decoded, so the
+/// caller can check them against its limits before allocating). Channels are in the file's (alphabetical)
+/// order. Throws lumx::Error naming `file`.
+struct ExrLayout {
+  int width = 0;
+  int height = 0;
+  std::vector<std::string> channels;
+};
+ExrLayout probe_exr(std::string_view bytes, const std::string& file);
+
 /// Decodes a whole image (for small payloads such as the radiance volume).
 ExrImage decode_exr(std::string_view bytes, const std::string& file, int width, int height,
                     const std::vector<std::string>& channels);
