@@ -125,7 +125,7 @@ struct AdaptiveKernelDensity2D::Impl {
       if (n.left < 0) {
         for (int i = n.begin; i < n.end; ++i) {
           const double du = x - u[std::size_t(i)], dv = y - v[std::size_t(i)];
-          const double t = 1.0 - (du * du + dv * dv) * inv_radius2[std::size_t(i)];
+          const double t = (1.0 - dv * dv * inv_radius2[std::size_t(i)]) - du * du * inv_radius2[std::size_t(i)];
           if (t > 0.0) sum += weight[std::size_t(i)] * t * t;
         }
       } else {
@@ -226,7 +226,9 @@ void splat_reflected(const std::vector<double>& u, const std::vector<double>& v,
                      const std::vector<double>& flux, double width, double height, int nx, int ny, int threads,
                      std::vector<double>& grid) {
   grid.assign(std::size_t(nx) * std::size_t(ny), 0.0);
-  const double cell_u = width / nx, cell_v = height / ny;
+  const double cell_u = width / nx, cell_v = height / ny, per_u = nx / width, per_v = ny / height;
+  std::vector<double> centre_u(std::size_t(nx) + 1);
+  for (int ix = 0; ix < nx; ++ix) centre_u[std::size_t(ix)] = (ix + 0.5) * cell_u;
   const std::size_t n = u.size();
   for_row_bands(ny, threads, [&](int row_begin, int row_end) {
     for (int sv = 0; sv < 3; ++sv)
@@ -236,21 +238,26 @@ void splat_reflected(const std::vector<double>& u, const std::vector<double>& v,
           const double cu = su == 0 ? u[i] : su == 1 ? -u[i] : 2.0 * width - u[i];
           const double cv = sv == 0 ? v[i] : sv == 1 ? -v[i] : 2.0 * height - v[i];
           if (cu + h <= 0.0 || cu - h >= width || cv + h <= 0.0 || cv - h >= height) continue;
-          const int y0 = std::max(row_begin, int(std::ceil((cv - h) / cell_v - 0.5)));
-          const int y1 = std::min(row_end - 1, int(std::floor((cv + h) / cell_v - 0.5)));
+          const int y0 = std::max(row_begin, int(std::ceil((cv - h) * per_v - 0.5)));
+          const int y1 = std::min(row_end - 1, int(std::floor((cv + h) * per_v - 0.5)));
           if (y0 > y1) continue;
           const double inv_h2 = 1.0 / (h * h);
           const double w = flux[i] * kBiweightNorm * inv_h2;
-          const int x0 = std::max(0, int(std::ceil((cu - h) / cell_u - 0.5)));
-          const int x1 = std::min(nx - 1, int(std::floor((cu + h) / cell_u - 0.5)));
           for (int iy = y0; iy <= y1; ++iy) {
             const double dv = (iy + 0.5) * cell_v - cv;
-            const double dv2 = dv * dv;
+            // Along the row K is a polynomial in du: t = a − du²/h², a = 1 − dv²/h²; only the columns with
+            // |du| < h √a are visited, and the clamp at 0 only catches rounding at their ends.
+            const double a = 1.0 - dv * dv * inv_h2;
+            if (a <= 0.0) continue;
+            const double half = h * std::sqrt(a);
+            const int x0 = std::max(0, int(std::ceil((cu - half) * per_u - 0.5)));
+            const int x1 = std::min(nx - 1, int(std::floor((cu + half) * per_u - 0.5)));
             double* row = grid.data() + std::size_t(iy) * std::size_t(nx);
+            const double* xs = centre_u.data();
             for (int ix = x0; ix <= x1; ++ix) {
-              const double du = (ix + 0.5) * cell_u - cu;
-              const double t = 1.0 - (du * du + dv2) * inv_h2;
-              row[ix] += t > 0.0 ? w * t * t : 0.0;
+              const double du = xs[ix] - cu;
+              const double t = std::max(0.0, a - du * du * inv_h2);
+              row[ix] += w * t * t;
             }
           }
         }
