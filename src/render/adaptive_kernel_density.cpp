@@ -252,15 +252,14 @@ void splat_reflected(const std::vector<double>& u, const std::vector<double>& v,
           if (y0 > y1) continue;
           const double inv_h2 = 1.0 / (h * h);
           const double w = flux[i] * kBiweightNorm * inv_h2;
+          // The columns of the kernel's bounding square; along a row K is a polynomial in du,
+          // t = a − du²/h² with a = 1 − dv²/h², clamped at 0 (cheaper than finding each row's chord).
+          const int x0 = std::max(0, int(std::ceil((cu - h) * per_u - 0.5)));
+          const int x1 = std::min(nx - 1, int(std::floor((cu + h) * per_u - 0.5)));
           for (int iy = y0; iy <= y1; ++iy) {
             const double dv = (iy + 0.5) * cell_v - cv;
-            // Along the row K is a polynomial in du: t = a − du²/h², a = 1 − dv²/h²; only the columns with
-            // |du| < h √a are visited, and the clamp at 0 only catches rounding at their ends.
             const double a = 1.0 - dv * dv * inv_h2;
             if (a <= 0.0) continue;
-            const double half = h * std::sqrt(a);
-            const int x0 = std::max(0, int(std::ceil((cu - half) * per_u - 0.5)));
-            const int x1 = std::min(nx - 1, int(std::floor((cu + half) * per_u - 0.5)));
             double* row = grid.data() + std::size_t(iy) * std::size_t(nx);
             const double* xs = centre_u.data();
             for (int ix = x0; ix <= x1; ++ix) {
