@@ -43,6 +43,7 @@
 
 #include <lumx/volume/radiance_volume.h>
 
+#include <lumx/render/adaptive_kernel_density.h>
 #include <lumx/render/camera.h>
 #include <lumx/render/image.h>
 
