@@ -196,8 +196,9 @@ TEST(AdaptiveKernelDensity, ATranslatedClusterGivesTheTranslatedEstimate) {
   // A cluster far from the edges, moved; h₀ = 0.08 m is given so that only the pilot's tabulation can
   // differ: it sits at cell centres δ = 3 m / ⌈3 m · 4/h₀⌉ = 0.02 m apart on a grid fixed to the rectangle.
   // Moved by whole cells (1.0, 0.5) m the estimate moves with it to rounding. Moved by a fraction of a cell,
-  // bilinear interpolation of the pilot is off by ≤ (δ²/8)|f̃''| ≈ f̃/128 for a kernel-smoothed f̃, which
-  // moves λ = (f̃/g)^{−1/2} by ≤ 0.4 % and the estimate (a kernel's height goes as 1/h²) by ≤ 1 %.
+  // bilinear interpolation of the pilot is off by ≤ (δ²/8)|∇²f̃|; f̃ here is close to a Gaussian of
+  // σ ≈ 0.09 m (the cluster's 0.08 m widened by the kernel), |∇²f̃| ≤ 2f̃/σ², so f̃ is off by ≤ δ²/(4σ²)
+  // ≈ 1.2 %, λ = (f̃/g)^{−1/2} by ≤ 0.6 %, and the estimate (a kernel's height goes as 1/h²) by ≤ 1.2 %.
   for (const double shift_u : {1.0, 1.013}) {
     UnitRandom r(5);
     std::vector<Deposit2D> d(4000), moved(4000);
@@ -219,7 +220,7 @@ TEST(AdaptiveKernelDensity, ATranslatedClusterGivesTheTranslatedEstimate) {
         peak = std::max(peak, ea);
       }
     EXPECT_GT(peak, 0.0);
-    EXPECT_LT(worst, (shift_u == 1.0 ? 1e-12 : 0.01) * peak) << "shift " << shift_u << " m";
+    EXPECT_LT(worst, (shift_u == 1.0 ? 1e-12 : 0.02) * peak) << "shift " << shift_u << " m";
   }
 }
 
