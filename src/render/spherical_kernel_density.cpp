@@ -17,6 +17,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 
 LUMX_NAMESPACE_BEGIN
 namespace render {
@@ -87,8 +88,6 @@ class KernelTree {
     }
     return s;
   }
-
-  const std::vector<Item>& items() const { return items_; }
 
  private:
   struct Node {
