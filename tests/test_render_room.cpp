@@ -5,9 +5,11 @@
 // closed form against the reference's kernel reconstruction (bias and noise measured); shadows of an
 // occluder; a baked luminaire's APLs against its reference; the same deposits for any thread count.
 #include "luminaire_test_scenes.h"
+#include "metrics_test_support.h"
 #include "test_support.h"
 
 #include <lumx/bake/bake.h>
+#include <lumx/apl/far_field.h>
 #include <lumx/bake/gltf_reader.h>
 #include <lumx/bake/tracer.h>
 #include <lumx/io/bundle_io.h>
@@ -124,6 +126,22 @@ TEST(RenderRoom, PointLightAplFollowsInverseSquareCosineLaw) {
   EXPECT_LT(render::relative_rmse(scene, maps, exact), 1e-6);
 }
 
+// (a) The far-field path: an isotropic photometry (I = 100 cd everywhere) through apl_set_from_photometry is
+// the same point light; its map is constant, so E = I cosθ / r² holds to float precision again.
+TEST(RenderRoom, FarFieldOfIsotropicPhotometryFollowsInverseSquareCosineLaw) {
+  const double intensity = 100.0;
+  render::Room room;
+  room.luminaire_position_m = {2.2, 0.9, 1.7};
+  const render::RoomScene scene(room);
+  const lumx::AplSet far = lumx::apl_set_from_photometry(rotational_photometry([&](double) { return intensity; }), 32);
+  const render::AplRoomIlluminance point(far, 0, room.luminaire_position_m, scene);
+  const render::SurfaceMaps maps = render::illuminance_maps(scene, point, 2);
+  const render::SurfaceMaps exact = point_light_maps(scene, room.luminaire_position_m, intensity);
+  for (std::size_t s = 0; s < maps.size(); ++s)
+    for (std::size_t t = 0; t < maps[s].size(); ++t)
+      ASSERT_NEAR(maps[s][t], exact[s][t], 1e-5 * exact[s][t] + 1e-9) << scene.surfaces()[s].name << " texel " << t;
+}
+
 // (a) The particle reference of the same light (a punctual emitter, Φ = 4πI): the flux landing on each
 // surface is I Ω (Ω its solid angle) within 4 binomial standard deviations, Φ √(p(1 − p)/N), p = Ω/4π;
 // and its kernel-reconstructed maps match I cosθ / r² on every surface, with the bias and noise of the
@@ -154,8 +172,11 @@ TEST(RenderRoom, PointLightReferenceFollowsInverseSquareCosineLaw) {
   const double noise = render::half_noise(scene, reference.even_half_maps(), reference.odd_half_maps(), exact);
   std::printf("point light, 2e5 particles: reference against I cos/r^2: relative RMSE %.4f, noise (halves) %.4f\n",
               rmse, noise);
-  EXPECT_LT(noise, 0.05);
-  EXPECT_LT(rmse, 1.0);
+  // Measured with the fixed-bandwidth kernel: RMSE 5.1 %, of which noise 2.3 % (halves) and the rest the
+  // kernel's smoothing of the peak 0.4 m below the light (bias ≈ h²/2 · ∇²E/E); the bound leaves room for
+  // neither to grow, and a sharper (adaptive) estimator only lowers both.
+  EXPECT_LT(noise, 0.035);
+  EXPECT_LT(rmse, 0.08);
 }
 
 
@@ -211,7 +232,12 @@ TEST(RenderRoom, DiskReferenceMatchesClosedFormOnTheCeiling) {
   std::printf("disk, 2e5 particles, ceiling rho < 1.2 m: relative RMSE %.4f, noise (halves/2) %.4f, mean bias %+.4f, "
               "on axis %.2f lx (exact %.2f)\n",
               rmse, 0.5 * halves, mean_bias, ref[centre], exact[centre]);
-  EXPECT_LT(rmse, 1.0);
+  // Measured with the fixed-bandwidth kernel (2e5 particles): RMSE 2.0 %, noise 1.9 %, mean bias −0.3 %,
+  // on the axis −2 % (the peak smoothed). Unbiased, the RMSE would equal the noise; the bound allows a 2 %
+  // bias on top, in quadrature, and 30 % for the noise estimate's own scatter. Kernel smoothing moves flux
+  // but keeps it, so the mean over the central disk is nearly unbiased: |mean bias| < 1 %.
+  EXPECT_LT(rmse, 1.3 * std::sqrt(0.25 * halves * halves + 0.02 * 0.02));
+  EXPECT_LT(std::abs(mean_bias), 0.01);
 }
 
 // (c) A 60 × 60 cm table top 5 cm thick at 0.7–0.75 m under a point light at 1.8 m: on the floor, a texel
@@ -295,11 +321,16 @@ TEST(RenderRoom, ReferenceDepositsDoNotDependOnThreads) {
   EXPECT_GT(one.deposited_lm, 0.0);
 }
 
-// (d) A baked luminaire (a point light in a white sphere with a port): the finest APL level lights the room
-// as the particle reference does, within the reference's noise and kernel bias and the level's own error.
+// (d) A baked luminaire (the Lambertian disk of luminaire_test_scenes.h, facing up, 1.7 m below the
+// ceiling): on the ceiling, which faces it, every APL level and the far field light the room as the particle
+// reference does, within their combined noise. The bake's maps (R = 8: 2 · 8² texels, ≈ 780 of the 10⁵
+// particles each) carry σ_map ≈ 1/√780 = 3.6 % per texel; the reference's noise σ_ref is measured from its
+// halves; independent, they add in quadrature, and the bound is 1.5 × √(σ_map² + σ_ref²). (The walls see the
+// disk's horizon as a sharp edge at its height, which a fixed kernel blurs; the reference's bias there is in
+// docs/render.md, so they are left out of this comparison.)
 TEST(RenderRoom, BakedSampleAplsAgreeWithReference) {
   const fs::path dir = fresh_temp_dir("lumx_render_room_baked");
-  const fs::path glb = write_sphere_luminaire(dir);
+  const fs::path glb = write_disk_luminaire(dir);
   lumx::bake::BakeOptions bo;
   bo.particles = 100000;
   bo.target_error = 0;
@@ -307,33 +338,45 @@ TEST(RenderRoom, BakedSampleAplsAgreeWithReference) {
   bo.threads = 2;
   bo.bundle.evaluate = false;
   bo.bundle.apl.level_counts = {1, 8, 64};
-  lumx::bake::bake_luminaire(glb.string(), (dir / "sphere.lumx").string(), bo);
-  const lumx::BundleReader bundle((dir / "sphere.lumx").string());
+  bo.bundle.apl.map_resolution = 8;
+  lumx::bake::bake_luminaire(glb.string(), (dir / "disk.lumx").string(), bo);
+  const lumx::BundleReader bundle((dir / "disk.lumx").string());
   const lumx::AplSet set = bundle.load();
   render::Room room;
-  room.luminaire_position_m = render::default_luminaire_position(room.size_m, set.bounds);
+  room.luminaire_position_m = {1.5, 1.5, 0.3};  // the ceiling 17 disk diameters away
   const render::RoomScene scene(room);
   const lumx::bake::LuminaireScene lamp = render::luminaire_of_bundle(bundle, (dir / "scratch").string());
   const lumx::bake::Tracer tracer(lamp);
   render::ReferenceOptions o;
-  o.particles = 100000;
+  o.particles = 200000;
   o.threads = 2;
   const render::RoomDeposits d = render::trace_room_particles(tracer, scene, room.luminaire_position_m, o);
   const render::ReferenceRoomIlluminance reference(scene, d, o.kernel);
-  const double noise =
-      render::half_noise(scene, reference.even_half_maps(), reference.odd_half_maps(), reference.texel_maps());
-  double rmse[3];
-  for (int k = 0; k < 3; ++k) {
-    const render::AplRoomIlluminance apl(set, k, room.luminaire_position_m, scene);
-    rmse[k] = render::relative_rmse(scene, render::illuminance_maps(scene, apl, 2), reference.texel_maps());
+  const std::size_t ceiling = 1;
+  const double noise = 0.5 * surface_rmse(reference.even_half_maps()[ceiling], reference.odd_half_maps()[ceiling]) *
+                       std::sqrt([&] {  // renormalised from the odd half's RMS to the whole's
+                         double a = 0, b = 0;
+                         for (std::size_t t = 0; t < reference.texel_maps()[ceiling].size(); ++t) {
+                           a += std::pow(reference.odd_half_maps()[ceiling][t], 2);
+                           b += std::pow(reference.texel_maps()[ceiling][t], 2);
+                         }
+                         return a / b;
+                       }());
+  const double bound = 1.5 * std::sqrt(1.0 / 780.0 + noise * noise);
+  std::vector<double> rmse;
+  for (std::size_t k = 0; k < set.levels.size(); ++k) {
+    const render::AplRoomIlluminance apl(set, int(k), room.luminaire_position_m, scene);
+    rmse.push_back(surface_rmse(render::illuminance_maps(scene, apl, 2)[ceiling], reference.texel_maps()[ceiling]));
   }
   const lumx::AplSet far = render::far_field_set_of_bundle(bundle);
   const render::AplRoomIlluminance far_field(far, 0, room.luminaire_position_m, scene);
-  const double far_rmse = render::relative_rmse(scene, render::illuminance_maps(scene, far_field, 2), reference.texel_maps());
-  std::printf("sphere luminaire, 1e5 particles: reference noise %.4f; relative RMSE 1 APL %.4f, 8 APLs %.4f, 64 APLs "
-              "%.4f, far field %.4f\n",
-              noise, rmse[0], rmse[1], rmse[2], far_rmse);
-  EXPECT_LT(rmse[2], 1.0);
+  const double far_rmse =
+      surface_rmse(render::illuminance_maps(scene, far_field, 2)[ceiling], reference.texel_maps()[ceiling]);
+  std::printf("baked disk, 1e5 particles, ceiling: reference noise %.4f; relative RMSE 1 APL %.4f, 8 APLs %.4f, "
+              "64 APLs %.4f, far field %.4f; bound %.4f\n",
+              noise, rmse[0], rmse[1], rmse[2], far_rmse, bound);
+  for (double e : rmse) EXPECT_LT(e, bound);
+  EXPECT_LT(far_rmse, bound);
 }
 
 }  // namespace
