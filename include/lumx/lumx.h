@@ -45,6 +45,7 @@
 
 #include <lumx/render/camera.h>
 #include <lumx/render/image.h>
+#include <lumx/render/room.h>
 
 #include <lumx/io/atomic_file.h>
 #include <lumx/io/bundle_io.h>
