@@ -8,6 +8,7 @@
 #include "build_command.h"
 #include "commands.h"
 #include "eval_commands.h"
+#include "render_appearance_command.h"
 
 #include <CLI/CLI.hpp>
 
@@ -248,6 +249,12 @@ const Command kCommands[] = {
        c.add_flag("--store-errors", g_eval.store_errors,
                   "--rays: store each level's relative RMSE table in the bundle (read by the LOD error target)");
        c.callback([&st] { st = lumx_cli::run_eval(g_eval); });
+     }},
+    {"render", "Render pictures of a bundle's luminaire: its appearance (depth-limited tracing with the glow, "
+               "against a path-traced reference)",
+     [](CLI::App& c, int& st) {
+       c.require_subcommand(1);
+       lumx_cli::add_render_appearance_command(c, st);
      }},
 };
 
