@@ -130,7 +130,7 @@ void write_difference_png(const Image& image, const Image& reference, const std:
     draw_pixels(pt, px, image.width, image.height, f, 0, kHeader, path);
     // Colour bar: −100 % … +100 % of the reference's luminance.
     const int bar_w = int(std::max(64.0, 0.8 * w)), bar_h = 12;
-    std::vector<std::uint32_t> bar(std::size_t(bar_w));
+    std::vector<std::uint32_t> bar(static_cast<std::size_t>(bar_w));
     for (int x = 0; x < bar_w; ++x) {
       const lumx::Rgb c = diverging(2.0 * (x + 0.5) / bar_w - 1.0);
       bar[std::size_t(x)] = argb(c.r, c.g, c.b);

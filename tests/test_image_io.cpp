@@ -12,6 +12,7 @@
 #include <fstream>
 
 using namespace lumx;
+using lumx_test::fresh_temp_dir;
 
 TEST(ImageIo, FloatImageRoundTripsExactlyWithItsChannelOrder) {
   const auto dir = fresh_temp_dir("image_io_round_trip");

@@ -94,7 +94,9 @@ TEST(RenderAppearance, EmissiveDiskSeenDirectlyHasItsLuminanceExactly) {
         }
         const lumx::render::CameraRay centre = camera.ray(x + 0.5, y + 0.5);
         const glm::dvec3 p = centre.origin + (-centre.origin.z / centre.direction.z) * centre.direction;
-        if (std::hypot(p.x, p.y) > 1.2 * kDiskRadius) ASSERT_EQ(r.image.at(x, y, 0), 0.0f);
+        if (std::hypot(p.x, p.y) > 1.2 * kDiskRadius) {
+          ASSERT_EQ(r.image.at(x, y, 0), 0.0f);
+        }
       }
     EXPECT_GT(inside, 100) << "depth " << depth;
   }
@@ -183,8 +185,10 @@ TEST(RenderAppearance, EmitterThroughAGlassSlabLosesTwoFresnelReflections) {
   EXPECT_LT(4.0 * standard_error, 0.01 * expected / pixels);  // the test resolves a 1 % error
 }
 
-/// An emissive ball (r = 3 cm, 2000 cd/m²) inside a diffusing shade: a sphere (r = 10 cm) that reflects 40 %
-/// and transmits 50 % diffusely, with a port at the top. Light scatters inside many times: the glow.
+/// A downlight disk (r = 5 cm, 2000 cd/m², facing down, 4 cm above the centre) inside a diffusing shade: a
+/// sphere (r = 10 cm) that reflects 40.5 % and transmits 49.5 % diffusely, with a port at the top. Light
+/// scatters inside many times: the glow. (A flat emitter keeps next-event estimation's variance low: every
+/// point of it is seen from most of the shade, where half of a ball's points would be hidden by the ball.)
 LuminaireScene shade_scene() {
   SceneBuilder b("shade");
   Material shade = lambertian(0.9);
@@ -192,8 +196,8 @@ LuminaireScene shade_scene() {
   shade.diffuse_transmission = 0.55;
   b.begin_part("shade", b.add_material(shade));
   b.sphere(glm::dmat4(1.0), 0.1, 12, 24, 0.6, true);
-  b.begin_part("ball", b.add_material(emissive(2000.0, true)));
-  b.sphere(glm::dmat4(1.0), 0.03, 6, 12, 0.0, true);
+  b.begin_part("downlight", b.add_material(emissive(2000.0)));
+  b.disk(glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.0, 0.04)), 0.05, 24, /*up=*/false);
   return b.scene();
 }
 
@@ -243,8 +247,8 @@ TEST(RenderAppearance, DepthLimitedImagesApproachTheReference) {
   const PinholeCamera camera = shade_camera(20, 16);
   lumx::render::DepthStudyOptions o;
   o.depths = {0, 1, 2, 8};
-  o.samples_per_pixel = 64;
-  o.reference_samples_per_pixel = 256;
+  o.samples_per_pixel = 256;
+  o.reference_samples_per_pixel = 2048;
   o.threads = 2;
   o.glow = false;
   const lumx::render::DepthStudy s = lumx::render::study_depths(renderer, camera, o);
@@ -261,16 +265,27 @@ TEST(RenderAppearance, DepthLimitedImagesApproachTheReference) {
   EXPECT_LT(std::abs(mean_difference) / std::sqrt(variance), 4.0);
 
   ASSERT_EQ(s.rows.size(), 4u);
+  // The error e of an image holds the noise of both images: E[e²] = b² + ν² + ν_ref² with b the relative
+  // RMSE of the expected images (the bias of stopping at n_b). b is estimated by removing the measured noise.
+  const auto bias = [&](const lumx::render::DepthRow& r) {
+    const double e2 = r.error_luminaire * r.error_luminaire - r.noise_luminaire * r.noise_luminaire -
+                      s.reference_noise_luminaire * s.reference_noise_luminaire;
+    return std::sqrt(std::max(0.0, e2));
+  };
+  for (const lumx::render::DepthRow& r : s.rows)
+    std::printf("n_b = %d: error %.4f, noise %.4f, bias %.4f (reference noise %.4f)\n", r.depth, r.error_luminaire,
+                r.noise_luminaire, bias(r), s.reference_noise_luminaire);
   const auto noise = [&](const lumx::render::DepthRow& r) {
     return std::sqrt(r.noise_luminaire * r.noise_luminaire + s.reference_noise_luminaire * s.reference_noise_luminaire);
   };
-  EXPECT_GT(s.rows[0].error_luminaire, 0.5);  // n_b = 0 shows only the ball where it peeks through the port
-  EXPECT_GT(s.rows[0].error_luminaire, s.rows[1].error_luminaire + noise(s.rows[1]));
-  EXPECT_GT(s.rows[1].error_luminaire, s.rows[2].error_luminaire + noise(s.rows[2]));
-  EXPECT_GT(s.rows[2].error_luminaire, s.rows[3].error_luminaire);
-  // At n_b = 8 the paths left out carry < 0.95⁸ ≈ 0.66 … of what they would at n_b = 2; what remains of
-  // the error is the two images' noise (the expected RMSE of pure noise is sqrt(ν² + ν_ref²); 2 of it).
-  EXPECT_LT(s.rows[3].error_luminaire, 2.0 * noise(s.rows[3]) + 0.03);
+  EXPECT_GT(bias(s.rows[0]), 0.9);  // n_b = 0 without glow: the shade is black from outside
+  EXPECT_GT(bias(s.rows[1]), 1.5 * bias(s.rows[2]));
+  EXPECT_GT(s.rows[2].error_luminaire, s.rows[3].error_luminaire + noise(s.rows[3]));
+  // Each extra event inside the shade returns at most its reflectance 0.405 of the light: the paths n_b = 8
+  // leaves out are ≲ 0.405⁶ ≈ 0.4 % of those n_b = 2 leaves out, so its error is the noise. The halves
+  // underestimate the noise of heavy-tailed estimates (rare long paths) somewhat at these sample counts
+  // (error / noise measured 1.05 here, 1.23 with a quarter of the samples); 1.5 leaves room for that only.
+  EXPECT_LT(s.rows[3].error_luminaire, 1.5 * noise(s.rows[3]));
   EXPECT_GE(s.suggested_depth, 2);
 }
 
@@ -334,6 +349,60 @@ TEST(RenderAppearance, RelativeErrorAndNoiseFromHalves) {
   EXPECT_EQ(lumx::render::suggest_depth_index({0.9, 0.3, 0.25, 0.24}, {0.0, 0.0, 0.0, 0.0}, 0.05), 2u);
   EXPECT_EQ(lumx::render::suggest_depth_index({0.9, 0.3, 0.25, 0.24}, {0.0, 0.07, 0.0, 0.0}, 0.05), 1u);
   EXPECT_EQ(lumx::render::suggest_depth_index({0.9, 0.5, 0.3}, {0.0, 0.0, 0.0}, 0.01), 2u);
+}
+
+std::uint32_t big_endian_u32(const std::string& bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | std::uint8_t(bytes.at(at + i));
+  return v;
+}
+
+// The CLI on a bundle baked here: it runs, its JSON parses and matches the images it wrote, the EXR images
+// read back with the camera's size, and the PNGs are PNGs of the size the layout gives.
+TEST(RenderAppearance, CliRendersABakedBundle) {
+  const std::filesystem::path dir = fresh_temp_dir("lumx_render_appearance_cli");
+  const std::filesystem::path glb = dir / "shade.glb";
+  lumx::bake::write_gltf_luminaire(shade_scene(), glb.string());
+  const CliRun bake = run_cli("bake " + quoted(glb) + " " + quoted(dir / "bundle") +
+                              " --particles 20000 --levels 1 8 --no-eval --volume-voxels 4096 --threads 2");
+  ASSERT_EQ(bake.status, 0) << bake.out;
+  const CliRun r = run_cli("render appearance " + quoted(dir / "bundle") + " -o " + quoted(dir / "out") +
+                               " --size 24 16 --spp 4 --reference-spp 16 --depths 2,0,1 --threads 2 --json",
+                           false);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("depths").size(), 3u);
+  EXPECT_EQ(j["depths"][0]["depth"], 0);
+  EXPECT_EQ(j["depths"][2]["depth"], 2);
+  EXPECT_TRUE(j["glow"].get<bool>());
+  EXPECT_GT(j["luminaire_pixels"].get<int>(), 10);
+  const int suggested = j["suggested_depth"].get<int>();
+  EXPECT_TRUE(suggested == 0 || suggested == 1 || suggested == 2);
+  for (const auto& row : j["depths"]) {
+    EXPECT_TRUE(std::isfinite(row["error_luminaire"].get<double>()));
+    EXPECT_GT(row["speedup"].get<double>(), 0.0);
+  }
+
+  for (const char* name : {"reference.exr", "depth_0.exr", "depth_2.exr"}) {
+    const Image im = lumx::read_exr_image((dir / "out" / name).string());
+    EXPECT_EQ(im.width, 24);
+    EXPECT_EQ(im.height, 16);
+    EXPECT_EQ(im.channels, (std::vector<std::string>{"R", "G", "B"}));
+  }
+  for (const char* name : {"reference.png", "depth_1.png", "difference_depth_1.png"}) {
+    const std::string png = read_text(dir / "out" / name);
+    ASSERT_GT(png.size(), 24u) << name;
+    EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << name;
+    EXPECT_EQ(big_endian_u32(png, 16), 336u) << name;  // 24 px × 14 (upscaled to at least 320)
+    const std::uint32_t h = big_endian_u32(png, 20);
+    EXPECT_EQ(h, std::string(name).rfind("difference", 0) == 0 ? 16u * 14u + 112u : 16u * 14u + 56u) << name;
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "table.txt"));
+  const nlohmann::json written = nlohmann::json::parse(read_text(dir / "out" / "table.json"));
+  EXPECT_EQ(written, j);
+  // A bundle that is not one is a located error, not a crash.
+  const CliRun bad = run_cli("render appearance " + quoted(dir / "nothing") + " -o " + quoted(dir / "out2"));
+  EXPECT_EQ(bad.status, 1) << bad.out;
 }
 
 TEST(RenderAppearance, InvalidCameraIsALocatedError) {
