@@ -60,15 +60,20 @@ double relative_noise(const Image& first_half, const Image& second_half, const I
   return std::sqrt(var / norm);
 }
 
+double noise_free_error(double error, double noise, double reference_noise) {
+  return std::sqrt(std::max(0.0, error * error - noise * noise - reference_noise * reference_noise));
+}
+
 std::size_t suggest_depth_index(const std::vector<double>& errors, const std::vector<double>& noises,
                                 double reference_noise) {
   if (errors.empty() || errors.size() != noises.size())
     throw std::invalid_argument("suggest_depth_index: one noise per error, at least one depth");
+  std::vector<double> bias(errors.size());
+  for (std::size_t k = 0; k < errors.size(); ++k) bias[k] = noise_free_error(errors[k], noises[k], reference_noise);
   for (std::size_t k = 0; k < errors.size(); ++k) {
     double best_deeper = std::numeric_limits<double>::infinity();
-    for (std::size_t j = k + 1; j < errors.size(); ++j) best_deeper = std::min(best_deeper, errors[j]);
-    const double noise = std::sqrt(noises[k] * noises[k] + reference_noise * reference_noise);
-    if (!(errors[k] > best_deeper + noise)) return k;  // NaN errors stop here too
+    for (std::size_t j = k + 1; j < errors.size(); ++j) best_deeper = std::min(best_deeper, bias[j]);
+    if (!(bias[k] > best_deeper + reference_noise)) return k;  // NaN errors stop here too
   }
   return errors.size() - 1;
 }
@@ -120,6 +125,7 @@ DepthStudy study_depths(const AppearanceRenderer& renderer, const PinholeCamera&
     row.error_luminaire = relative_rmse(row.render.image, ref, on_luminaire);
     row.error_all = relative_rmse(row.render.image, ref, nullptr);
     row.noise_luminaire = relative_noise(row.render.first_half, row.render.second_half, ref, on_luminaire);
+    row.bias_luminaire = noise_free_error(row.error_luminaire, row.noise_luminaire, study.reference_noise_luminaire);
     row.speedup = study.reference.seconds / std::max(row.render.seconds, 1e-9);
     errors.push_back(row.error_luminaire);
     noises.push_back(row.noise_luminaire);
@@ -128,19 +134,18 @@ DepthStudy study_depths(const AppearanceRenderer& renderer, const PinholeCamera&
   const std::size_t k = suggest_depth_index(errors, noises, study.reference_noise_luminaire);
   study.suggested_depth = depths[k];
   double best_deeper = std::numeric_limits<double>::infinity();
-  for (std::size_t j = k + 1; j < errors.size(); ++j) best_deeper = std::min(best_deeper, errors[j]);
+  for (std::size_t j = k + 1; j < errors.size(); ++j) best_deeper = std::min(best_deeper, study.rows[j].bias_luminaire);
   char buf[512];
   if (k + 1 < errors.size())
     std::snprintf(buf, sizeof buf,
-                  "n_b = %d: its error %.4f on the %s pixels is within the noise %.4f of the best deeper error %.4f "
-                  "(smallest depth no deeper one beats by more than the noise)",
-                  depths[k], errors[k], on_luminaire ? "luminaire's" : "image's",
-                  std::sqrt(noises[k] * noises[k] + study.reference_noise_luminaire * study.reference_noise_luminaire),
-                  best_deeper);
+                  "n_b = %d: its noise-free error %.4f on the %s pixels is within the reference's noise %.4f of the "
+                  "best deeper one, %.4f (the smallest depth no deeper one beats by more)",
+                  depths[k], study.rows[k].bias_luminaire, on_luminaire ? "luminaire's" : "image's",
+                  study.reference_noise_luminaire, best_deeper);
   else
     std::snprintf(buf, sizeof buf,
-                  "n_b = %d: the deepest depth measured; every shallower one is beaten by more than the noise "
-                  "(try deeper depths)",
+                  "n_b = %d: the deepest depth measured; every shallower one is beaten by more than the reference's "
+                  "noise (try deeper depths)",
                   depths[k]);
   study.rule = buf;
   return study;

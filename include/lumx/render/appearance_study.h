@@ -10,12 +10,16 @@
 // pixel has variance ≈ (A − B)²/4, so an image's relative noise is ν = sqrt(Σ (Y_A − Y_B)²/4) / sqrt(Σ Y_ref²)
 // on the same pixels: the part of e that Monte Carlo noise alone explains is sqrt(ν² + ν_ref²).
 //
-// Suggested n_b (000 §5.4 leaves the choice open). Over the depths d_0 < d_1 < … measured, the smallest d_k
-// that no deeper depth beats by more than the noise, on the luminaire's pixels:
-//   e(d_k) ≤ min_{j>k} e(d_j) + sqrt(ν(d_k)² + ν_ref²)
-// — going deeper than d_k buys no improvement that the reference (and the image's own noise) could resolve.
-// When no pixel shows the luminaire, the rule runs on all pixels. The rule needs a reference whose noise
-// is below the differences between depths; with too few reference samples it suggests the smallest depth.
+// Noise-free error. E[e²] = b² + ν² + ν_ref², with b the relative RMSE between the two images' expectations
+// (the bias of stopping at n_b, and of the glow); b is estimated as sqrt(max(0, e² − ν² − ν_ref²)).
+//
+// Suggested n_b (000 §5.4 leaves the choice open). Over the depths measured, d_0 < d_1 < …, the smallest d_k
+// whose noise-free error no deeper depth beats by more than the reference's noise, on the luminaire's pixels:
+//   b(d_k) ≤ min_{j>k} b(d_j) + ν_ref
+// — a deeper image is closer to the reference only by what the reference itself cannot resolve. When no
+// pixel shows the luminaire, the rule runs on all pixels. It needs a reference whose noise is below the
+// differences between depths (raise its samples otherwise); the noise estimates from halves are themselves
+// uncertain for heavy-tailed estimates (rare long paths), which makes b uncertain by a similar amount.
 //
 // Speed-up = reference time / depth-limited time, each for its own samples per pixel (stated in the table).
 #pragma once
@@ -56,6 +60,7 @@ struct DepthRow {
   double error_luminaire = 0;  ///< relative RMSE over the luminaire's pixels
   double error_all = 0;        ///< relative RMSE over all pixels
   double noise_luminaire = 0;  ///< ν of this image over the luminaire's pixels
+  double bias_luminaire = 0;   ///< noise-free error b over the luminaire's pixels
   double speedup = 0;          ///< reference seconds / this image's seconds
 };
 
@@ -72,6 +77,9 @@ struct DepthStudy {
 
 /// Renders the reference, then each depth, and applies the rule. Throws lumx::Error for invalid options.
 DepthStudy study_depths(const AppearanceRenderer& renderer, const PinholeCamera& camera, const DepthStudyOptions& options);
+
+/// sqrt(max(0, e² − ν² − ν_ref²)): the error e with both images' noise removed.
+double noise_free_error(double error, double noise, double reference_noise);
 
 /// The rule alone: index into `errors` (increasing depth) of the suggested depth, given each depth's own
 /// noise and the reference's. Throws std::invalid_argument for empty or mismatched inputs.
