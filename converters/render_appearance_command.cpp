@@ -214,12 +214,12 @@ int run_render_appearance(const RenderAppearanceArgs& a) {
     t << "reference: " << s.reference.samples_per_pixel << " spp, " << fixed(s.reference.seconds, 3)
       << " s, noise " << fixed(100 * s.reference_noise_luminaire, 2) << " % (luminaire), "
       << fixed(100 * s.reference_noise_all, 2) << " % (all); " << s.reference.depth_capped << " paths at the depth cap\n";
-    t << "  n_b   spp    time s   error lum. %   error all %   noise %   noise-free %   speed-up\n";
+    t << "  n_b   spp    time s   error lum. %   error all %   noise %   noise-free %   speed-up   per sample\n";
     for (const lumx::render::DepthRow& r : s.rows) {
       char line[200];
-      std::snprintf(line, sizeof line, "  %3d  %4d  %8.3f  %13.2f  %12.2f  %8.2f  %13.2f  %9.1f\n", r.depth,
+      std::snprintf(line, sizeof line, "  %3d  %4d  %8.3f  %13.2f  %12.2f  %8.2f  %13.2f  %9.1f  %11.2f\n", r.depth,
                     r.render.samples_per_pixel, r.render.seconds, 100 * r.error_luminaire, 100 * r.error_all,
-                    100 * r.noise_luminaire, 100 * r.bias_luminaire, r.speedup);
+                    100 * r.noise_luminaire, 100 * r.bias_luminaire, r.speedup, r.speedup_per_sample);
       t << line;
     }
     t << "suggested n_b = " << s.suggested_depth << ": " << s.rule << "\n";
@@ -252,6 +252,7 @@ int run_render_appearance(const RenderAppearanceArgs& a) {
                       {"noise_luminaire", r.noise_luminaire},
                       {"noise_free_error_luminaire", r.bias_luminaire},
                       {"speedup", r.speedup},
+                      {"speedup_per_sample", r.speedup_per_sample},
                       {"exr", "depth_" + std::to_string(r.depth) + ".exr"}});
     j["depths"] = rows;
     j["suggested_depth"] = s.suggested_depth;

@@ -127,6 +127,8 @@ DepthStudy study_depths(const AppearanceRenderer& renderer, const PinholeCamera&
     row.noise_luminaire = relative_noise(row.render.first_half, row.render.second_half, ref, on_luminaire);
     row.bias_luminaire = noise_free_error(row.error_luminaire, row.noise_luminaire, study.reference_noise_luminaire);
     row.speedup = study.reference.seconds / std::max(row.render.seconds, 1e-9);
+    row.speedup_per_sample = row.speedup * double(row.render.samples_per_pixel) /
+                             double(std::max(1, study.reference.samples_per_pixel));
     errors.push_back(row.error_luminaire);
     noises.push_back(row.noise_luminaire);
     study.rows.push_back(std::move(row));

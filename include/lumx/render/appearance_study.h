@@ -21,7 +21,8 @@
 // differences between depths (raise its samples otherwise); the noise estimates from halves are themselves
 // uncertain for heavy-tailed estimates (rare long paths), which makes b uncertain by a similar amount.
 //
-// Speed-up = reference time / depth-limited time, each for its own samples per pixel (stated in the table).
+// Speed-up = reference time / depth-limited time, each for its own samples per pixel (stated in the table);
+// per sample, the same ratio with each time divided by its samples per pixel.
 #pragma once
 
 #include <lumx/render/appearance.h>
@@ -62,6 +63,9 @@ struct DepthRow {
   double noise_luminaire = 0;  ///< ν of this image over the luminaire's pixels
   double bias_luminaire = 0;   ///< noise-free error b over the luminaire's pixels
   double speedup = 0;          ///< reference seconds / this image's seconds
+  /// The same per sample per pixel: (reference seconds / its spp) / (seconds / spp), what a sample of the
+  /// depth-limited image costs against one of the reference.
+  double speedup_per_sample = 0;
 };
 
 struct DepthStudy {
