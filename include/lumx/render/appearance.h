@@ -24,14 +24,17 @@
 //     sample ∝ luminance × area and a shadow ray), combined with the hits by the power heuristic (Veach
 //     1997 §9.2). Shadow rays stop at any surface, glass included: light reaching a vertex only through
 //     specular glass is found by BSDF sampling alone;
-//   - punctual, spot, IES and rayset emitters have no area: no eye ray hits them and they are not sampled
-//     directly, so they appear only through the glow (the radiance volume holds their scattered light)
-//     and, in the reference, not at all;
+//   - punctual, spot and IES emitters have no area: no eye ray hits them (they are invisible themselves);
+//     they light every non-specular vertex in sight through next-event estimation (E = I(ω)/r²), in both
+//     the depth-limited images and the reference, and reach the glow through the bake's particles. Rayset
+//     emitters are neither hit nor sampled: they appear through the glow only;
 //   - depth-limited rendering (AppearanceOptions::depth = n_b ≥ 0): at the vertex reached after n_b
 //     scattering events the path ends; a non-emissive surface returns the glow, the radiance volume's
-//     radiance at the hit point along the direction toward the eye (propagation direction −d,
-//     lumx/volume/radiance_volume.h), an emissive one its emission only. n_b = 0 therefore shows the
-//     emitters and the glow at the first hit; no volume = black glow;
+//     radiance along the direction toward the eye (propagation direction −d, lumx/volume/radiance_volume.h),
+//     looked up at the hit point moved back along the last segment by min(half of it, one voxel) when that
+//     segment started on the luminaire (radiance is constant along it; the volume holds no exits, so voxels
+//     straddling an outer wall are part empty); an emissive surface returns its emission only. n_b = 0
+//     therefore shows the emitters and the glow at the first hit; no volume = black glow;
 //   - the reference (depth = kReferenceDepth): Russian roulette from `roulette_depth` events on
 //     (survival = max channel of the throughput, capped at 1, survivors divided by it), a hard cap at
 //     `reference_max_depth` (counted), no glow.
