@@ -330,6 +330,27 @@ TEST(RenderAppearance, SameImageForOneAndTwoThreads) {
   }
 }
 
+// A time limit ends the render after a whole pass: with a limit already spent the first pass of 4 samples is
+// all there is, and it is the same as the first 4 samples of a render without a limit.
+TEST(RenderAppearance, TimeLimitKeepsWholePasses) {
+  const LuminaireScene scene = shade_scene();
+  const AppearanceRenderer renderer(scene, nullptr, nullptr);
+  const PinholeCamera camera = shade_camera(8, 6);
+  AppearanceOptions o = options(lumx::render::kReferenceDepth, 64);
+  o.pass_samples = 4;
+  o.time_limit_seconds = 1e-12;
+  int calls = 0;
+  o.progress = [&](double fraction) {
+    ++calls;
+    EXPECT_DOUBLE_EQ(fraction, 4.0 / 64.0);
+  };
+  const AppearanceImage limited = renderer.render(camera, o);
+  EXPECT_EQ(limited.samples_per_pixel, 4);
+  EXPECT_EQ(calls, 1);
+  AppearanceOptions four = options(lumx::render::kReferenceDepth, 4);
+  EXPECT_EQ(renderer.render(camera, four).image.pixels, limited.image.pixels);
+}
+
 TEST(RenderAppearance, RelativeErrorAndNoiseFromHalves) {
   Image ref(2, 1, {"R", "G", "B"}, 1.0f), im(2, 1, {"R", "G", "B"}, 1.0f);
   for (int c = 0; c < 3; ++c) im.at(1, 0, c) = 3.0f;
@@ -397,7 +418,8 @@ TEST(RenderAppearance, CliRendersABakedBundle) {
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "table.txt"));
   const nlohmann::json written = nlohmann::json::parse(read_text(dir / "out" / "table.json"));
   EXPECT_EQ(written, j);
-  // A bundle that is not one is a located error, not a crash.
+  // `lumx render` needs its subcommand; a bundle that is not one is a located error, not a crash.
+  EXPECT_NE(run_cli("render").status, 0);
   const CliRun bad = run_cli("render appearance " + quoted(dir / "nothing") + " -o " + quoted(dir / "out2"));
   EXPECT_EQ(bad.status, 1) << bad.out;
 }
