@@ -132,8 +132,8 @@ void add_render_appearance_command(CLI::App& render, int& status) {
 
 int run_render_appearance(const RenderAppearanceArgs& a) {
   return guarded(a.bundle, [&] {
-    std::filesystem::create_directories(a.out);
     const lumx::BundleReader bundle(a.bundle);
+    std::filesystem::create_directories(a.out);  // once the bundle is known to be one
     const lumx::bake::LuminaireScene scene = read_luminaire(bundle, a);
     std::optional<lumx::RadianceVolume> volume;
     if (!a.no_glow && bundle.has_volume()) volume.emplace(bundle.load_volume());
