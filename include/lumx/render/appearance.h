@@ -26,8 +26,10 @@
 //     specular glass is found by BSDF sampling alone;
 //   - punctual, spot and IES emitters have no area: no eye ray hits them (they are invisible themselves);
 //     they light every non-specular vertex in sight through next-event estimation (E = I(ω)/r²), in both
-//     the depth-limited images and the reference, and reach the glow through the bake's particles. Rayset
-//     emitters are neither hit nor sampled: they appear through the glow only;
+//     the depth-limited images and the reference, and reach the glow through the bake's particles. Their
+//     light that reaches a surface only through another one (a point light inside a glass bulb) is found by
+//     neither strategy: the reference misses it, the depth-limited images have it through the glow only.
+//     Rayset emitters are neither hit nor sampled: they appear through the glow only;
 //   - depth-limited rendering (AppearanceOptions::depth = n_b ≥ 0): at the vertex reached after n_b
 //     scattering events the path ends; a non-emissive surface returns the glow, the radiance volume's
 //     radiance along the direction toward the eye (propagation direction −d, lumx/volume/radiance_volume.h),
