@@ -2,7 +2,7 @@
 // Copyright Contributors to the lumx project.
 // lumx/render/appearance.h: emitters seen directly and through a mirror and a glass slab against closed forms,
 // the reference's halves, depth-limited images converging to the reference, the glow's benefit, determinism,
-// and `lumx render appearance` end to end.
+// the APL-lit room (lumx/render/apl_room_background.h), and `lumx render appearance` end to end.
 #include "cli_test_support.h"
 #include "luminaire_test_scenes.h"
 #include "test_support.h"
@@ -10,6 +10,7 @@
 #include <lumx/bake/fresnel.h>
 #include <lumx/bake/tracer.h>
 #include <lumx/io/image_io.h>
+#include <lumx/render/apl_room_background.h>
 #include <lumx/render/appearance.h>
 #include <lumx/render/appearance_study.h>
 
@@ -433,6 +434,42 @@ TEST(RenderAppearance, InvalidCameraIsALocatedError) {
   LuminaireScene empty;
   empty.name = "empty";
   EXPECT_THROW(AppearanceRenderer(empty, nullptr, nullptr), lumx::Error);
+}
+
+}  // namespace
+
+namespace {
+
+// The default room: a wall's luminance is ρE/π with E the APL level's irradiance there. One isotropic APL of
+// 100 cd, 1.95 m above the floor's centre: E = I/h² below it. The floor's table samples cell centres
+// 3 m / 48 = 6.25 cm apart, and the centre falls halfway between four of them; bilinear interpolation of
+// E = I h / r³ there is off by ≈ (3/2)(3.125 cm / h)² ≈ 4·10⁻⁴ relative, so 10⁻³ bounds it.
+TEST(RenderAppearance, AplRoomWallsAreLambertianUnderTheApls) {
+  lumx::AplSet set;
+  set.channels = lumx::ChannelLayout::luminance;
+  lumx::AplLevel level;
+  level.map_resolution = 16;
+  lumx::Apl apl;
+  apl.position = {0.0f, 0.0f, -0.05f};
+  apl.map = lumx::SphereMap(16, 1);
+  for (int y = 0; y < apl.map.height(); ++y)
+    for (int x = 0; x < apl.map.width(); ++x) apl.map.at(x, y, 0) = 100.0f;
+  level.apls.push_back(apl);
+  set.levels.push_back(level);
+  lumx::render::AplRoomOptions o;
+  o.room.lo = {-1.5, -1.5, -2.0};
+  o.room.hi = {1.5, 1.5, 0.0};
+  o.albedo = 0.5;
+  const lumx::render::AplRoomBackground room(set, 0, o);
+  const double h = 1.95, expected = 0.5 * 100.0 / (h * h) / lumx::kPi;  // cd/m²
+  const glm::dvec3 below = room({0.0, 0.0, -0.05}, {0.0, 0.0, -1.0});
+  EXPECT_NEAR(below.x, expected, 1e-3 * expected);
+  EXPECT_EQ(below.x, below.z);  // one-channel sets are grey
+  // The ceiling is 5 cm above the APL: far brighter (the table interpolates a field peaked there).
+  const glm::dvec3 above = room({0.0, 0.0, -0.05}, {0.0, 0.0, 1.0});
+  EXPECT_GT(above.x, 100.0 * expected);
+  // Outside the room: black.
+  EXPECT_EQ(room({0.0, 0.0, 1.0}, {0.0, 0.0, -1.0}).x, 0.0);
 }
 
 }  // namespace
