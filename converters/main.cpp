@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "eval_commands.h"
 #include "render_room_command.h"
+#include "render_appearance_command.h"
 
 #include <CLI/CLI.hpp>
 
@@ -252,9 +253,10 @@ const Command kCommands[] = {
        c.callback([&st] { st = lumx_cli::run_eval(g_eval); });
      }},
     {"render", "Render pictures of a bundle's luminaire: 'room' = the luminaire lighting an empty room, by a "
-               "particle-traced reference, each APL level, level of detail and the far field, compared (docs/render.md)",
+               "particle-traced reference, each APL level, level of detail and the far field, compared (docs/render.md); 'appearance' = the luminaire as a camera sees it, depth-limited tracing with the glow against a path-traced reference (docs/appearance.md)",
      [](CLI::App& c, int& st) {
        c.require_subcommand(1, 1);
+       lumx_cli::add_render_appearance_command(c, st);
        CLI::App* room = c.add_subcommand(
            "room", "Direct illuminance of an empty room (default 3 x 3 x 2 m, the luminaire 10 cm from the right wall): "
                    "EXR and PNG pictures with log-spaced iso-lines per method, difference images against the "
