@@ -8,6 +8,8 @@
 #include "build_command.h"
 #include "commands.h"
 #include "eval_commands.h"
+#include "render_room_command.h"
+#include "render_appearance_command.h"
 
 #include <CLI/CLI.hpp>
 
@@ -31,6 +33,7 @@ lumx_cli::PlotArgs g_plot;
 lumx_cli::BuildArgs g_build;
 lumx_cli::BakeArgs g_bake;
 lumx_cli::EvalArgs g_eval;
+lumx_cli::RenderRoomArgs g_render_room;
 
 /// Refuses nan/inf for angle options (CLI11's number parsing accepts them).
 const CLI::Validator finite(
@@ -248,6 +251,48 @@ const Command kCommands[] = {
        c.add_flag("--store-errors", g_eval.store_errors,
                   "--rays: store each level's relative RMSE table in the bundle (read by the LOD error target)");
        c.callback([&st] { st = lumx_cli::run_eval(g_eval); });
+     }},
+    {"render", "Render pictures of a bundle's luminaire: 'room' = the luminaire lighting an empty room, by a "
+               "particle-traced reference, each APL level, level of detail and the far field, compared (docs/render.md); 'appearance' = the luminaire as a camera sees it, depth-limited tracing with the glow against a path-traced reference (docs/appearance.md)",
+     [](CLI::App& c, int& st) {
+       c.require_subcommand(1, 1);
+       lumx_cli::add_render_appearance_command(c, st);
+       CLI::App* room = c.add_subcommand(
+           "room", "Direct illuminance of an empty room (default 3 x 3 x 2 m, the luminaire 10 cm from the right wall): "
+                   "EXR and PNG pictures with log-spaced iso-lines per method, difference images against the "
+                   "reference, and a table of relative RMSE, time and speed-up");
+       auto& r = g_render_room;
+       room->add_option("bundle", r.bundle, "bundle folder (lumx bake's: it ships the luminaire's glTF for the reference)")
+           ->required();
+       room->add_option("-o,--output", r.out, "folder for the pictures, images and table")->required();
+       room->add_option("--room", r.room, "room size W D H, m (default 3 3 2)")->expected(3);
+       room->add_option("--luminaire-at", r.luminaire_at,
+                        "where the bundle's frame origin hangs, X Y Z in m (default: bounding sphere 10 cm from the "
+                        "wall x = W and below the ceiling, at mid-depth)")
+           ->expected(3);
+       room->add_option("--occluder", r.occluders, "a box x0 y0 z0 x1 y1 z1 (m) that casts shadows; repeatable")
+           ->expected(6)
+           ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+       room->add_option("--albedo", r.albedo, "diffuse reflectance of every surface (default 0.5)")->check(CLI::Range(0.0, 1.0));
+       room->add_option("--eye", r.eye, "camera position X Y Z, m")->expected(3);
+       room->add_option("--look-at", r.look_at, "point the camera looks at, X Y Z, m")->expected(3);
+       room->add_option("--fov", r.fov, "vertical field of view, degrees (default 75)")->check(CLI::Range(1.0, 170.0));
+       room->add_option("--size", r.size, "picture size W H, pixels (default 480 320)")->expected(2);
+       room->add_option("--particles", r.particles, "the reference's particles (default 1000000)")
+           ->check(CLI::Range(std::uint64_t(1000), std::uint64_t(1) << 40));
+       room->add_option("--levels", r.levels, "APL counts of the stored levels to render (default: all)");
+       room->add_option("--seed", r.seed, "seed of the particles and of level-of-detail choices (default 1)");
+       room->add_option("--threads", r.threads, "threads (default: every core; the results are the same for any count)")
+           ->check(CLI::Range(0u, 256u));
+       room->add_option("--time-limit", r.time_limit, "seconds: the reference stops tracing after the pass that passes "
+                                                      "it, its fluxes rescaled (default: none)")
+           ->check(CLI::Range(0.0, 1e9));
+       room->add_option("--difference-range", r.difference_range,
+                        "relative difference at the ends of the difference images' colour bar (default 0.5 = 50 %)")
+           ->check(CLI::Range(0.001, 100.0));
+       room->add_flag("--progress", r.progress, "show the progress bar even when stderr is not a terminal");
+       room->add_flag("--json", r.json, "print the table as JSON");
+       room->callback([&st] { st = lumx_cli::run_render_room(g_render_room); });
      }},
 };
 

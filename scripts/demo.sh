@@ -6,7 +6,9 @@
 #  0. four procedural glTF luminaires (samples/sample_luminaires.cpp); the troffer (three tubes behind a
 #     prismatic refractor) baked: light particles traced through its geometry in passes until 5 % error
 #     at d = 1 on held-out particles or 1 M particles -> a bundle with APL levels, held-out error tables,
-#     radiance volume and far field; its table, plots, per-pass previews, far field as IES;
+#     radiance volume and far field; its table, plots, per-pass previews, far field as IES; the troffer
+#     lighting a 3 x 3 x 2 m room with a table, rendered by particles (reference), its APL levels and its
+#     far field, side by side with iso-lines, difference images and an error/time table;
 #  1. a procedural 8-die LED strip written as a TM-25 rayset (samples/led_strip_rays.cpp) -> a lumx
 #     bundle: APL levels by clustering, each level's error against the rays, the far field; prints the
 #     speed-against-error table, writes its plots;
@@ -37,6 +39,12 @@ rm -rf "$out/troffer_preview"
 "$lumx" plot "$out/troffer.lumx" -o "$out/troffer_apls.svg"
 echo "(plots in $out/troffer_plots, per-pass preview images and errors in $out/troffer_preview, far field"
 echo " $out/troffer.ies and its polar plot, APL picture $out/troffer_apls.svg)"
+echo "== lumx render room $out/troffer.lumx -> $out/troffer_room (reference, APL levels, LOD, far field)"
+rm -rf "$out/troffer_room"
+"$lumx" render room "$out/troffer.lumx" -o "$out/troffer_room" --luminaire-at 2.2 1.5 1.9 \
+  --occluder 1.7 1.1 0.7 2.5 1.9 0.75 --particles 1000000 | tee "$out/troffer_room.txt"
+echo "(reference | 512 APLs | far field side by side: $out/troffer_room/room_comparison.png; per method EXR,"
+echo " iso-line PNG and difference image in $out/troffer_room)"
 rays=$out/led_strip.tm25ray
 echo "== samples/led_strip_rays.cpp writes a synthetic LED strip's rays -> $rays"
 "$dir/samples/led_strip_rays" "$rays" --rays 200000 --seed 1

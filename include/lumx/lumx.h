@@ -46,6 +46,7 @@
 #include <lumx/render/adaptive_kernel_density.h>
 #include <lumx/render/camera.h>
 #include <lumx/render/image.h>
+#include <lumx/render/room.h>
 #include <lumx/render/spherical_kernel_density.h>
 
 #include <lumx/io/atomic_file.h>
