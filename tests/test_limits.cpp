@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "io/bundle/exr_image.h"
 #include "rayset_test_support.h"
 #include "test_support.h"
 
@@ -286,6 +287,23 @@ TEST(Robustness, JsonNestedDeeperThan256LevelsIsRefusedBeforeParsing) {
   EXPECT_EQ(d.field, "JSON");
   EXPECT_EQ(d.byte_offset, 11 + 255);  // the bracket that opens level 257
   fs::remove_all(dir);
+}
+
+TEST(Robustness, ExrAttributeLargerThanThePayloadIsRefusedBeforeOpenExrAllocates) {
+  // Found by fuzz_bundle (tests/data/fuzz/bundle/exr_attribute_2gib.exr): OpenEXR allocates and clears an
+  // attribute's declared size before reading it, 2 GiB here for a 29-byte payload.
+  const std::string exr = lumx_test::read_text(lumx_test::data_dir() / "fuzz" / "bundle" / "exr_attribute_2gib.exr");
+  ASSERT_EQ(exr.size(), 29u);
+  const Bounded r = run_bounded([&] { (void)detail::decode_exr(exr, "a.exr", 16, 8, {"Y"}); });
+  EXPECT_TRUE(r.threw);
+  EXPECT_EQ(r.byte_offset, 24) << r.message;  // the attribute's size field
+  EXPECT_NE(r.message.find("2147483647"), std::string::npos) << r.message;
+  EXPECT_LT(r.seconds, 1.0);
+  EXPECT_LT(r.grown_kb, 8 * 1024);
+  // A payload lumx wrote still decodes.
+  const std::string good =
+      lumx_test::read_text(lumx_test::data_dir() / "fuzz" / "bundle" / "level00_n00001_r0008.exr");
+  EXPECT_EQ(detail::decode_exr(good, "good.exr", 16, 8, {"Y"}).pixels.size(), 128u);
 }
 
 // ---- hostile 100 MB files: refused, or read in bounded time and memory -----------------------------------
