@@ -12,8 +12,9 @@
 # build-fuzz-ci/ at -O1 with line tables only (as OSS-Fuzz does; a quarter less compile time), runs as many
 # targets at once as there are cores, runs every target even after a finding, and exits non-zero if any
 # target found a crash, a leak, a timeout (25 s) or an out-of-memory (2 GiB).
-# A crash is saved under out/fuzz/<target>/artifacts/; once fixed, copy it to tests/data/fuzz/<target>/ so
-# that CTest replays it (fuzz_replay.<target>) in every build.
+# A crash is saved under out/fuzz/<target>/artifacts/ (--ci: out/fuzz/ci/<target>/artifacts/, beside its log,
+# so that a CI run never mixes with an offline one); once fixed, copy it to tests/data/fuzz/<target>/ so that
+# CTest replays it (fuzz_replay.<target>) in every build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ci=0
@@ -45,11 +46,14 @@ lum=out/fuzz/luminaires
 if [ ! -d "$lum" ] && [ -x build/samples/sample_luminaires ]; then build/samples/sample_luminaires "$lum" > /dev/null; fi
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export LSAN_OPTIONS="suppressions=$(pwd)/scripts/lsan.supp"
-# One target: seeds into its corpus, then libFuzzer; the exit status goes to out/fuzz/<target>/status.
+# Offline runs keep their corpora, logs and artifacts in out/fuzz/<target>/, CI runs in out/fuzz/ci/<target>/.
+out=out/fuzz
+[ $ci = 1 ] && out=out/fuzz/ci
+# One target: seeds into its corpus, then libFuzzer; the exit status goes to $out/<target>/status.
 run_target() {
-  local t=$1 corpus max_len
-  if [ $ci = 1 ]; then corpus=out/fuzz/ci/$t; rm -rf "$corpus"; else corpus=out/fuzz/$t/corpus; fi
-  mkdir -p "$corpus" "out/fuzz/$t/artifacts"
+  local t=$1 corpus=$out/$t/corpus max_len
+  [ $ci = 1 ] && rm -rf "$corpus"
+  mkdir -p "$corpus" "$out/$t/artifacts"
   # Seed names: the path with '/' as '_' and no leading dots (hidden files would not be counted).
   seed() { for f in "$@"; do [ -f "$f" ] && cp -n "$f" "$corpus/$(echo "$f" | tr '/' '_' | sed 's/^[._]*//')" 2>/dev/null || true; done; }
   case $t in
@@ -65,9 +69,9 @@ run_target() {
   [ -d "tests/data/fuzz/$t" ] && seed tests/data/fuzz/"$t"/*
   local status=0
   "$bdir"/tests/fuzz/lumx_fuzz_"$t" "$corpus" -dict="tests/fuzz/dict/$t.dict" -max_total_time="$seconds" \
-    -max_len="$max_len" -timeout=25 -rss_limit_mb=2048 -artifact_prefix="out/fuzz/$t/artifacts/" \
-    -print_final_stats=1 > "out/fuzz/$t/log.txt" 2>&1 || status=$?
-  echo "$status $(ls "$corpus" | wc -l)" > "out/fuzz/$t/status"
+    -max_len="$max_len" -timeout=25 -rss_limit_mb=2048 -artifact_prefix="$out/$t/artifacts/" \
+    -print_final_stats=1 > "$out/$t/log.txt" 2>&1 || status=$?
+  echo "$status $(ls "$corpus" | wc -l)" > "$out/$t/status"
 }
 
 # Offline: one target after the other. CI: as many at once as there are cores (each keeps its SECONDS).
@@ -81,8 +85,8 @@ done
 wait
 failed=()
 for t in "${targets[@]}"; do
-  log=out/fuzz/$t/log.txt
-  read -r status corpus_files < "out/fuzz/$t/status"
+  log=$out/$t/log.txt
+  read -r status corpus_files < "$out/$t/status"
   echo "== lumx_fuzz_$t: exit $status, corpus of $corpus_files files at the end"
   grep -E "^#[0-9]+ *(DONE|INITED)|stat::number_of_executed_units|stat::peak_rss|ERROR|SUMMARY|Test unit written" \
     "$log" | tail -5 || true
@@ -94,6 +98,6 @@ for t in "${targets[@]}"; do
 done
 echo "== fuzzing took $(( $(date +%s) - start )) s in all (build included)"
 if [ ${#failed[@]} -ne 0 ]; then
-  echo "== findings in: ${failed[*]} (inputs under out/fuzz/<target>/artifacts/)"
+  echo "== findings in: ${failed[*]} (inputs under $out/<target>/artifacts/)"
   exit 1
 fi
