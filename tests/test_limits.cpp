@@ -306,6 +306,22 @@ TEST(Robustness, ExrAttributeLargerThanThePayloadIsRefusedBeforeOpenExrAllocates
   EXPECT_EQ(detail::decode_exr(good, "good.exr", 16, 8, {"Y"}).pixels.size(), 128u);
 }
 
+TEST(Robustness, RefusedBundlesLeaveNoFileDescriptorOpen) {
+  // Found by fuzz_bundle: every refused manifest left the bundle's folder open, until fopen failed.
+  const fs::path d = fresh_dir("fds");
+  const fs::path b = seed_bundle(d);
+  write_file(b / "manifest.json", "{\"format\": 1}");
+  auto open_fds = [] {
+    std::size_t n = 0;
+    for (const auto& e : fs::directory_iterator("/proc/self/fd")) n += e.exists() ? 1 : 0;
+    return n;
+  };
+  const std::size_t before = open_fds();
+  for (int i = 0; i < 100; ++i) EXPECT_THROW(BundleReader r(b.string()), Error);
+  EXPECT_EQ(open_fds(), before);
+  fs::remove_all(d);
+}
+
 // ---- hostile 100 MB files: refused, or read in bounded time and memory -----------------------------------
 
 TEST(Robustness, Hostile100MBIesFileIsRefusedOrReadInBoundedTimeAndMemory) {

@@ -343,10 +343,17 @@ BundleReader::BundleReader(const std::string& path, const BundleLimits& limits) 
   const std::string manifest_path = join(path, bundle::kManifestName);
   folder_fd_ = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (folder_fd_ < 0) fail(path, "bundle", errno == ENOENT ? "does not exist" : "is not a folder");
-  const int fd = open_inside(folder_fd_, bundle::kManifestName, manifest_path, "manifest");
-  const std::string text = read_fd(fd, manifest_path, "manifest", 0, limits.max_manifest_bytes, "BundleLimits::max_manifest_bytes");
-  bytes_read_ += text.size();
-  manifest_ = detail::parse_manifest(text, manifest_path, limits);
+  try {
+    const int fd = open_inside(folder_fd_, bundle::kManifestName, manifest_path, "manifest");
+    const std::string text =
+        read_fd(fd, manifest_path, "manifest", 0, limits.max_manifest_bytes, "BundleLimits::max_manifest_bytes");
+    bytes_read_ += text.size();
+    manifest_ = detail::parse_manifest(text, manifest_path, limits);
+  } catch (...) {  // no destructor runs for a constructor that throws (fuzz_bundle ran out of descriptors)
+    ::close(folder_fd_);
+    folder_fd_ = -1;
+    throw;
+  }
 }
 
 BundleReader::~BundleReader() {
