@@ -584,6 +584,21 @@ TEST(GltfBadInput, SizeLimitsComeFromTheOptions) {
   EXPECT_EQ(error_with([](auto& o) { o.max_triangles = 3; }).field, "/nodes/1");
   EXPECT_EQ(error_with([](auto& o) { o.max_vertices = 7; }).field, "/nodes/1");
   EXPECT_EQ(error_with([](auto& o) { o.max_parts = 1; }).field, "/nodes/1/mesh");
+  EXPECT_EQ(error_with([](auto& o) { o.max_nodes_placed = 1; }).field, "/nodes");
+  // Each error names the option to raise.
+  const std::vector<std::pair<std::function<void(bake::GltfReadOptions&)>, std::string>> named = {
+      {[](bake::GltfReadOptions& o) { o.max_file_bytes = 100; }, "GltfReadOptions::max_file_bytes (100)"},
+      {[](bake::GltfReadOptions& o) { o.max_buffer_bytes = 10; }, "GltfReadOptions::max_buffer_bytes (10)"},
+      {[](bake::GltfReadOptions& o) { o.max_vertices = 3; }, "GltfReadOptions::max_vertices (3)"},
+      {[](bake::GltfReadOptions& o) { o.max_triangles = 1; }, "GltfReadOptions::max_triangles + 2 (5)"},
+      {[](bake::GltfReadOptions& o) { o.max_triangles = 3; }, "GltfReadOptions::max_triangles (3)"},
+      {[](bake::GltfReadOptions& o) { o.max_vertices = 7; }, "GltfReadOptions::max_vertices (7)"},
+      {[](bake::GltfReadOptions& o) { o.max_parts = 1; }, "GltfReadOptions::max_parts (1)"},
+      {[](bake::GltfReadOptions& o) { o.max_nodes_placed = 1; }, "GltfReadOptions::max_nodes_placed (1)"}};
+  for (const auto& [limit, name] : named) {
+    const std::string message = error_with(limit).message;
+    EXPECT_NE(message.find(name), std::string::npos) << message;
+  }
   bake::GltfReadOptions exact;
   exact.max_triangles = 4;
   exact.max_vertices = 8;
@@ -605,7 +620,9 @@ TEST(GltfBadInput, MalformedJsonAndGlbContainersAreLocatedByByteOffset) {
   lumx_gltf_test::write_text(dir / "array.gltf", "[1, 2]");
   EXPECT_EQ(read_error(dir / "array.gltf").field, "");
   lumx_gltf_test::write_text(dir / "deep.gltf", std::string(200000, '[') + std::string(200000, ']'));
-  EXPECT_EQ(read_error(dir / "deep.gltf").field, "");  // parsed and freed without recursion
+  d = read_error(dir / "deep.gltf");  // refused before parsing: each bracket would cost ~80 bytes of heap
+  EXPECT_EQ(d.field, "JSON");
+  EXPECT_EQ(d.byte_offset, 256);  // the bracket that opens level 257
 
   const std::vector<std::uint8_t> good = emissive_quad().glb_bytes();
   auto variant = [&](const char* name, const std::function<void(std::vector<std::uint8_t>&)>& edit) {
@@ -656,6 +673,17 @@ TEST(GltfBadInput, CorruptDracoPayloadsAreLocatedErrors) {
   b.doc["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["bufferView"] = 40;
   b.write_glb(dir / "view.glb");
   EXPECT_EQ(read_error(dir / "view.glb").field, "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression/bufferView");
+  // The accessors' counts are checked against the limits before Draco decodes (the payload is garbage, so
+  // a decode would fail at the buffer view instead).
+  bake::GltfReadOptions few;
+  few.max_vertices = 3;
+  try {
+    bake::read_gltf_luminaire((dir / "garbage.glb").string(), few);
+    ADD_FAILURE() << "read within the limits";
+  } catch (const lumx::Error& e) {
+    EXPECT_EQ(e.diagnostic().field, "/accessors/0/count");
+    EXPECT_NE(e.diagnostic().message.find("GltfReadOptions::max_vertices (3)"), std::string::npos) << e.what();
+  }
 }
 
 namespace {

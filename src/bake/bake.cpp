@@ -130,7 +130,7 @@ BakeResult bake_luminaire(const std::string& luminaire, const std::string& out, 
   };
   report("reading", 0);
 
-  const std::string bytes = read_file_bounded(luminaire, options.read.max_file_bytes);
+  const std::string bytes = read_file_bounded(luminaire, options.read.max_file_bytes, "GltfReadOptions::max_file_bytes");
   const LuminaireScene scene = read_gltf_luminaire(luminaire, options.read);
   const Tracer tracer(scene);
   result.luminaire_name = scene.name;

@@ -3,6 +3,7 @@
 // The container layer of the glTF reader (src/bake/gltf_document.h): GLB chunks, JSON, buffers, buffer
 // views, accessors and Draco primitives, validated before they are read.
 #include "bake/gltf_document.h"
+#include "io/json_depth.h"
 
 #include <draco/compression/decode.h>
 #include <draco/core/decoder_buffer.h>
@@ -104,8 +105,9 @@ std::vector<std::uint8_t> read_file_bytes(const std::string& path, std::uint64_t
   const std::uint64_t size = std::filesystem::file_size(p, ec);
   if (ec) throw_at_field(error_file, pointer, "cannot read the size of '" + path + "'");
   if (size > max_bytes)
-    throw_at_field(error_file, pointer, "'" + path + "' has " + std::to_string(size) + " bytes, more than the limit of " +
-                                            std::to_string(max_bytes));
+    throw_at_field(error_file, pointer, "'" + path + "' has " + std::to_string(size) +
+                                            " bytes, more than GltfReadOptions::max_file_bytes (" +
+                                            std::to_string(max_bytes) + ")");
   const std::uint64_t n = std::min(size, want);
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(n));
   std::ifstream f(p, std::ios::binary);
@@ -249,8 +251,8 @@ Document::Document(const std::string& path, const GltfReadOptions& options)
   const std::uint64_t size = std::filesystem::file_size(path, ec);
   if (ec) throw_at_field(path, "", "cannot read the file size");
   if (size > options.max_file_bytes)
-    throw_at_offset(path, 0, "file size", std::to_string(size) + " bytes, more than the limit of " +
-                                              std::to_string(options.max_file_bytes));
+    throw_at_offset(path, 0, "file size", std::to_string(size) + " bytes, more than GltfReadOptions::max_file_bytes (" +
+                                              std::to_string(options.max_file_bytes) + ")");
   file_.resize(static_cast<std::size_t>(size));
   {
     std::ifstream f(path, std::ios::binary);
@@ -304,6 +306,10 @@ Document::Document(const std::string& path, const GltfReadOptions& options)
     }
     if (!have_json) throw_at_offset(path, 12, "GLB chunk", "the file has no JSON chunk");
   }
+  if (const std::size_t at = lumx::detail::json_too_deep_at(std::string_view(reinterpret_cast<const char*>(json_begin), json_size));
+      at != std::string_view::npos)
+    throw_at_offset(path, json_offset + std::int64_t(at), "JSON",
+                    "nested more than " + std::to_string(lumx::detail::kMaxJsonDepth) + " levels deep");
   try {
     json_ = Json::parse(json_begin, json_begin + json_size);
   } catch (const Json::parse_error& e) {
@@ -385,8 +391,8 @@ Bytes Document::buffer(std::uint32_t index) {
   const JsonRef j = root().member("buffers").element(index);
   const std::uint64_t length = j.integer("byteLength", std::nullopt, 1, std::numeric_limits<std::uint64_t>::max());
   if (buffer_bytes_loaded_ + length > options_.max_buffer_bytes)
-    fail(ptr + "/byteLength", std::to_string(length) + " bytes would bring the buffers loaded to more than the limit of " +
-                                  std::to_string(options_.max_buffer_bytes));
+    fail(ptr + "/byteLength", std::to_string(length) + " bytes would bring the buffers loaded above "
+                              "GltfReadOptions::max_buffer_bytes (" + std::to_string(options_.max_buffer_bytes) + ")");
   if (!j.has("uri")) {
     if (!is_glb_ || index != 0) fail(ptr, "has no uri (only buffer 0 of a .glb file may use the BIN chunk)");
     if (bin_chunk_.data == nullptr) fail(ptr, "refers to the GLB BIN chunk, but the file has none");
@@ -431,6 +437,12 @@ Bytes Document::buffer_view(std::uint32_t index) {
   return Bytes{b.data + offset, static_cast<std::size_t>(length)};
 }
 
+std::uint64_t Document::accessor_count(std::uint32_t index) const {
+  const JsonRef a = root().member("accessors").element(index);
+  a.require_object();
+  return a.integer("count", std::nullopt, 1, std::numeric_limits<std::uint64_t>::max());
+}
+
 Document::AccessorView Document::accessor(std::uint32_t index, const char* type, std::uint64_t max_count) {
   const std::string ptr = "/accessors/" + std::to_string(index);
   const JsonRef a = root().member("accessors").element(index);
@@ -445,7 +457,9 @@ Document::AccessorView Document::accessor(std::uint32_t index, const char* type,
   if (t != type) fail(ptr + "/type", "is \"" + t + "\", but " + type + " is needed here");
   const std::uint64_t n = a.integer("count", std::nullopt, 1, std::numeric_limits<std::uint64_t>::max());
   if (n > max_count)
-    fail(ptr + "/count", "is " + std::to_string(n) + ", more than the limit of " + std::to_string(max_count));
+    fail(ptr + "/count", "is " + std::to_string(n) + ", more than " +
+                             (t == "SCALAR" ? "3 x GltfReadOptions::max_triangles + 2 (" : "GltfReadOptions::max_vertices (") +
+                             std::to_string(max_count) + ")");
   const bool normalized = a.boolean("normalized", false);
   const std::uint64_t offset = a.integer("byteOffset", 0, 0, std::numeric_limits<std::uint64_t>::max());
   if (!a.has("bufferView")) fail(ptr + "/bufferView", "is required here (an accessor of zeros is no geometry)");
@@ -536,11 +550,11 @@ LocalPrimitive Document::decode_draco(const JsonRef& ext, std::uint64_t max_vert
   const std::uint64_t points = mesh->num_points();
   const std::uint64_t faces = mesh->num_faces();
   if (points > max_vertices)
-    fail(where, "the Draco mesh has " + std::to_string(points) + " vertices, more than the limit of " +
-                    std::to_string(max_vertices));
+    fail(where, "the Draco mesh has " + std::to_string(points) + " vertices, more than GltfReadOptions::max_vertices (" +
+                    std::to_string(max_vertices) + ")");
   if (faces > max_triangles)
-    fail(where, "the Draco mesh has " + std::to_string(faces) + " triangles, more than the limit of " +
-                    std::to_string(max_triangles));
+    fail(where, "the Draco mesh has " + std::to_string(faces) + " triangles, more than GltfReadOptions::max_triangles (" +
+                    std::to_string(max_triangles) + ")");
 
   auto read_attribute = [&](const char* name, std::vector<glm::vec3>& out) {
     const JsonRef id_ref = attributes.member(name);

@@ -97,6 +97,8 @@ class Document {
   std::vector<glm::vec3> read_vec3(std::uint32_t accessor, std::uint64_t max_count);
   /// SCALAR unsigned byte/short/int accessor.
   std::vector<std::uint32_t> read_indices(std::uint32_t accessor, std::uint64_t max_count);
+  /// The `count` an accessor states (checked against the limits before Draco decodes a primitive).
+  std::uint64_t accessor_count(std::uint32_t accessor) const;
   /// Decodes a KHR_draco_mesh_compression primitive (`ext` is the extension object).
   LocalPrimitive decode_draco(const JsonRef& ext, std::uint64_t max_vertices, std::uint64_t max_triangles);
 

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <string_view>
 #include <utility>
@@ -266,8 +267,8 @@ class SceneBuilder {
       name = doc_.path() + "#" + l.pointer;
     }
     if (bytes.size() > ro.limits.max_file_bytes)
-      l.fail("the profile has " + std::to_string(bytes.size()) + " bytes, more than the limit of " +
-             std::to_string(ro.limits.max_file_bytes));
+      l.fail("the profile has " + std::to_string(bytes.size()) + " bytes, more than ReadLimits::max_file_bytes (" +
+             std::to_string(ro.limits.max_file_bytes) + ")");
     const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     auto profile = std::make_shared<const Photometry>(read_ies(text, name, ro));
     ies_profiles_[index] = profile;
@@ -426,7 +427,8 @@ class SceneBuilder {
       Placement p = stack.back();
       stack.pop_back();
       if (++visits > options_.max_nodes_placed)
-        doc_.fail("/nodes", "the scene places more than " + std::to_string(options_.max_nodes_placed) + " nodes");
+        doc_.fail("/nodes", "the scene places more nodes than GltfReadOptions::max_nodes_placed (" +
+                                std::to_string(options_.max_nodes_placed) + ")");
       const JsonRef node = doc_.root().member("nodes").element(p.node);
       node.require_object();
       p.to_world = p.to_world * local_matrix(node);
@@ -469,9 +471,33 @@ class SceneBuilder {
     LocalPrimitive out;
     const bool draco = p.has("extensions") && p.member("extensions").has("KHR_draco_mesh_compression");
     if (draco) {
-      attributes.index("POSITION", accessors, "accessors");
+      // A Draco primitive's accessors still state its counts: they are checked against the limits before
+      // Draco decodes (and allocates), and the decoded mesh must then have exactly those counts.
+      const std::uint32_t position = attributes.index("POSITION", accessors, "accessors");
+      const std::uint64_t declared_vertices = doc_.accessor_count(position);
+      const std::string position_count = "/accessors/" + std::to_string(position) + "/count";
+      if (declared_vertices > max_v)
+        doc_.fail(position_count, "is " + std::to_string(declared_vertices) + ", more than GltfReadOptions::max_vertices (" +
+                                      std::to_string(max_v) + "); the Draco payload is not decoded");
+      std::optional<std::uint64_t> declared_indices;
+      std::string indices_count;
+      if (p.has("indices")) {
+        const std::uint32_t ia = p.index("indices", accessors, "accessors");
+        declared_indices = doc_.accessor_count(ia);
+        indices_count = "/accessors/" + std::to_string(ia) + "/count";
+        if (*declared_indices > max_i)
+          doc_.fail(indices_count, "is " + std::to_string(*declared_indices) +
+                                       ", more than 3 x GltfReadOptions::max_triangles + 2 (" + std::to_string(max_i) +
+                                       "); the Draco payload is not decoded");
+      }
       const JsonRef ext = p.member("extensions").member("KHR_draco_mesh_compression");
       out = doc_.decode_draco(ext, max_v, options_.max_triangles);
+      if (out.positions.size() != declared_vertices)
+        doc_.fail(position_count, "is " + std::to_string(declared_vertices) + ", but the Draco mesh has " +
+                                      std::to_string(out.positions.size()) + " vertices");
+      if (declared_indices && out.indices.size() != *declared_indices)
+        doc_.fail(indices_count, "is " + std::to_string(*declared_indices) + ", but the Draco mesh has " +
+                                     std::to_string(out.indices.size()) + " indices");
       if (mode != 4) p.member("mode").fail("a Draco-compressed primitive must be TRIANGLES");
     } else {
       out.positions = doc_.read_vec3(attributes.index("POSITION", accessors, "accessors"), max_v);
@@ -528,7 +554,8 @@ class SceneBuilder {
       const JsonRef prims = doc_.root().member("meshes").element(m).member("primitives");
       parts += prims.array_size();
       if (parts > options_.max_parts)
-        node.member("mesh").fail("the scene would have more than " + std::to_string(options_.max_parts) + " parts");
+        node.member("mesh").fail("the scene would have more parts than GltfReadOptions::max_parts (" +
+                                 std::to_string(options_.max_parts) + ")");
       if (!decoded.insert(m).second) continue;
       for (std::uint32_t k = 0; k < prims.array_size(); ++k) {
         LocalPrimitive lp = decode_primitive(m, k);
@@ -537,11 +564,11 @@ class SceneBuilder {
         decoded_vertices += lp.positions.size();
         decoded_triangles += lp.indices.size() / 3;
         if (decoded_vertices > options_.max_vertices)
-          prims.element(k).fail("decoding the meshes would hold more than " + std::to_string(options_.max_vertices) +
-                                " vertices");
+          prims.element(k).fail("decoding the meshes would hold more vertices than GltfReadOptions::max_vertices (" +
+                                std::to_string(options_.max_vertices) + ")");
         if (decoded_triangles > options_.max_triangles)
-          prims.element(k).fail("decoding the meshes would hold more than " +
-                                std::to_string(options_.max_triangles) + " triangles");
+          prims.element(k).fail("decoding the meshes would hold more triangles than GltfReadOptions::max_triangles (" +
+                                std::to_string(options_.max_triangles) + ")");
         any_normals_ = any_normals_ || !lp.normals.empty();
         primitives_.emplace(std::make_pair(m, k), std::move(lp));
       }
@@ -573,9 +600,11 @@ class SceneBuilder {
     const bool flat = any_normals_ && lp.normals.empty();
     const std::uint64_t new_vertices = flat ? lp.indices.size() : lp.positions.size();
     if (scene_.positions.size() + new_vertices > options_.max_vertices)
-      doc_.fail(where, "the scene would have more than " + std::to_string(options_.max_vertices) + " vertices");
+      doc_.fail(where, "the scene would have more vertices than GltfReadOptions::max_vertices (" +
+                           std::to_string(options_.max_vertices) + ")");
     if (scene_.triangle_count() + lp.indices.size() / 3 > options_.max_triangles)
-      doc_.fail(where, "the scene would have more than " + std::to_string(options_.max_triangles) + " triangles");
+      doc_.fail(where, "the scene would have more triangles than GltfReadOptions::max_triangles (" +
+                           std::to_string(options_.max_triangles) + ")");
 
     Part part;
     part.name = name;

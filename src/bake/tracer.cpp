@@ -211,6 +211,12 @@ struct Tracer::Impl {
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    // Embree requires every coordinate of the origin and direction to be finite and below 1.8e18
+    // (FLT_LARGE; its debug builds assert it): a ray from out there, or one whose path overflowed, hits
+    // nothing (found by fuzz_gltf: tests/data/fuzz/gltf/embree_ray_origin_beyond_flt_large.glb).
+    constexpr float kEmbreeLarge = 1.8e18f;
+    for (const float v : {rh.ray.org_x, rh.ray.org_y, rh.ray.org_z, rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z})
+      if (!(std::abs(v) < kEmbreeLarge)) return rh;
     rtcIntersect1(rtc_scene, &context, &rh);
     return rh;
   }

@@ -109,7 +109,7 @@ void write_file_atomically(const std::string& path, std::string_view bytes) {
   ::close(dfd);
 }
 
-std::string read_file_bounded(const std::string& path, std::size_t max_bytes) {
+std::string read_file_bounded(const std::string& path, std::size_t max_bytes, const std::string& limit_name) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) fail(path, "cannot open", ENOENT);
   const auto size = std::filesystem::file_size(path, ec);
@@ -118,7 +118,8 @@ std::string read_file_bounded(const std::string& path, std::size_t max_bytes) {
     Diagnostic d;
     d.file = path;
     d.field = "file size";
-    d.message = "file is " + std::to_string(size) + " bytes, above the limit of " + std::to_string(max_bytes);
+    d.message = "file is " + std::to_string(size) + " bytes, above " +
+                (limit_name.empty() ? "the limit" : limit_name) + " (" + std::to_string(max_bytes) + ")";
     throw Error(std::move(d));
   }
   std::ifstream f(path, std::ios::binary);

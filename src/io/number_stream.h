@@ -12,6 +12,7 @@
 #include "io/text_scanner.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -73,6 +74,20 @@ class NumberStream {
       throw_at_line(file_, last_line_, field,
                     "value " + format(v) + " outside the accepted range " + std::to_string(lo) + ".." +
                         std::to_string(hi));
+    return static_cast<long>(v);
+  }
+
+  /// Next value as a count in [lo, limit], where `limit` comes from an option the error names
+  /// ("ReadLimits::max_angles"), so that an embedder knows what to raise.
+  long next_count(const std::string& field, long lo, std::size_t limit, const char* limit_name) {
+    const long hi = static_cast<long>(std::min<std::size_t>(limit, static_cast<std::size_t>(LONG_MAX)));
+    const double v = next_number(field);
+    if (v != std::floor(v)) throw_at_line(file_, last_line_, field, "expected a whole number, found " + format(v));
+    if (v < static_cast<double>(lo))
+      throw_at_line(file_, last_line_, field, "value " + format(v) + " is below " + std::to_string(lo));
+    if (v > static_cast<double>(hi))
+      throw_at_line(file_, last_line_, field,
+                    "value " + format(v) + " exceeds " + limit_name + " (" + std::to_string(limit) + ")");
     return static_cast<long>(v);
   }
 

@@ -27,7 +27,8 @@ void remove_stale_temporaries(const std::string& target);
 /// Replaces `path` with `bytes`. Throws lumx::Error naming the path and the failing step.
 void write_file_atomically(const std::string& path, std::string_view bytes);
 
-/// Reads a whole file, refusing files larger than `max_bytes`. Throws lumx::Error.
-std::string read_file_bounded(const std::string& path, std::size_t max_bytes);
+/// Reads a whole file, refusing files larger than `max_bytes`; the error names `limit_name` (the option that
+/// set the bound, e.g. "ReadLimits::max_file_bytes") when given. Throws lumx::Error.
+std::string read_file_bounded(const std::string& path, std::size_t max_bytes, const std::string& limit_name = {});
 
 LUMX_NAMESPACE_END

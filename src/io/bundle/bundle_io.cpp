@@ -288,9 +288,9 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
 namespace {
 
 /// Reads a whole file opened with `fd` (closed on return), refusing anything but a regular file of
-/// exactly `expected` bytes (or at most `limit` bytes when expected is 0).
+/// exactly `expected` bytes (or at most `limit` bytes, the BundleLimits member `limit_name`, when expected is 0).
 std::string read_fd(int fd, const std::string& file, const std::string& field, std::uint64_t expected,
-                    std::uint64_t limit) {
+                    std::uint64_t limit, const char* limit_name = "the limit") {
   struct Closer {
     int fd;
     ~Closer() { ::close(fd); }
@@ -301,7 +301,7 @@ std::string read_fd(int fd, const std::string& file, const std::string& field, s
   if (expected > 0 && size != expected)
     fail(file, field + "/bytes", "file has " + std::to_string(size) + " bytes, the manifest says " + std::to_string(expected));
   if (expected == 0 && size > limit)
-    fail(file, field, "file has " + std::to_string(size) + " bytes, more than the limit " + std::to_string(limit));
+    fail(file, field, "file has " + std::to_string(size) + " bytes, more than " + limit_name + " (" + std::to_string(limit) + ")");
   std::string bytes(std::size_t(size), '\0');
   std::size_t done = 0;
   while (done < bytes.size()) {
@@ -343,10 +343,17 @@ BundleReader::BundleReader(const std::string& path, const BundleLimits& limits) 
   const std::string manifest_path = join(path, bundle::kManifestName);
   folder_fd_ = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (folder_fd_ < 0) fail(path, "bundle", errno == ENOENT ? "does not exist" : "is not a folder");
-  const int fd = open_inside(folder_fd_, bundle::kManifestName, manifest_path, "manifest");
-  const std::string text = read_fd(fd, manifest_path, "manifest", 0, limits.max_manifest_bytes);
-  bytes_read_ += text.size();
-  manifest_ = detail::parse_manifest(text, manifest_path, limits);
+  try {
+    const int fd = open_inside(folder_fd_, bundle::kManifestName, manifest_path, "manifest");
+    const std::string text =
+        read_fd(fd, manifest_path, "manifest", 0, limits.max_manifest_bytes, "BundleLimits::max_manifest_bytes");
+    bytes_read_ += text.size();
+    manifest_ = detail::parse_manifest(text, manifest_path, limits);
+  } catch (...) {  // no destructor runs for a constructor that throws (fuzz_bundle ran out of descriptors)
+    ::close(folder_fd_);
+    folder_fd_ = -1;
+    throw;
+  }
 }
 
 BundleReader::~BundleReader() {
@@ -449,7 +456,8 @@ AplSet BundleReader::load(const std::vector<std::size_t>& levels, int max_resolu
                std::uint64_t(channel_count(manifest_.channels)) * sizeof(float);
   }
   if (max_resolution <= 0 && decoded > limits_.max_loaded_bytes)
-    fail(path_, "levels", "loading them would take " + std::to_string(decoded) + " bytes, above BundleLimits::max_loaded_bytes");
+    fail(path_, "levels", "loading them would take " + std::to_string(decoded) + " bytes, above BundleLimits::max_loaded_bytes (" +
+                                 std::to_string(limits_.max_loaded_bytes) + ")");
   AplSet set = empty_set();
   std::size_t previous = std::size_t(-1);
   for (std::size_t k : chosen) {

@@ -2,6 +2,7 @@
 // Copyright Contributors to the lumx project.
 // src/io/bundle/bundle_manifest.cpp — manifest serialisation and validating parser.
 #include "io/bundle/bundle_manifest.h"
+#include "io/json_depth.h"
 
 #include <lumx/math/sphere_map.h>
 
@@ -93,12 +94,16 @@ class Reader {
     if (!std::isfinite(v)) fail(pointer, "not finite");
     return v;
   }
-  long long integer(const json& j, const std::string& pointer, long long lo, long long hi) const {
+  /// `limit_name` names the BundleLimits member `hi` comes from, if it does.
+  long long integer(const json& j, const std::string& pointer, long long lo, long long hi,
+                    const char* limit_name = nullptr) const {
     if (!j.is_number_integer() && !j.is_number_unsigned()) fail(pointer, "expected an integer");
+    const std::string bound = limit_name ? std::string(limit_name) + " (" + std::to_string(hi) + ")" : std::to_string(hi);
     if (j.is_number_unsigned() && j.get<unsigned long long>() > (unsigned long long)hi)
-      fail(pointer, "exceeds " + std::to_string(hi));
+      fail(pointer, std::to_string(j.get<unsigned long long>()) + " exceeds " + bound);
     const long long v = j.get<long long>();
-    if (v < lo || v > hi) fail(pointer, std::to_string(v) + " outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    if (v > hi) fail(pointer, std::to_string(v) + " exceeds " + bound);
+    if (v < lo) fail(pointer, std::to_string(v) + " outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v;
   }
   std::string string(const json& j, const std::string& pointer) const {
@@ -122,7 +127,8 @@ class Reader {
     if (p.file.empty() || p.file.front() == '/' || p.file.find('\\') != std::string::npos ||
         p.file.find("..") != std::string::npos || p.file.find('\0') != std::string::npos)
       fail(pointer + "/file", "\"" + p.file + "\" is not a relative path inside the bundle");
-    p.bytes = std::uint64_t(integer(member(j, pointer, "bytes"), pointer + "/bytes", 1, (long long)limits.max_payload_bytes));
+    p.bytes = std::uint64_t(integer(member(j, pointer, "bytes"), pointer + "/bytes", 1, (long long)limits.max_payload_bytes,
+                                   "BundleLimits::max_payload_bytes"));
     p.sha256 = string(member(j, pointer, "sha256"), pointer + "/sha256");
     if (p.sha256.size() != 64 || p.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
       fail(pointer + "/sha256", "not 64 lowercase hexadecimal digits");
@@ -197,6 +203,14 @@ std::string manifest_to_json(const BundleManifest& m) {
 BundleManifest parse_manifest(std::string_view text, const std::string& file, const BundleLimits& limits) {
   Reader r(file);
   json j;
+  if (const std::size_t at = detail::json_too_deep_at(text); at != std::string_view::npos) {
+    Diagnostic d;
+    d.file = file;
+    d.byte_offset = std::int64_t(at);
+    d.field = "JSON";
+    d.message = "nested more than " + std::to_string(detail::kMaxJsonDepth) + " levels deep";
+    throw Error(std::move(d));
+  }
   try {
     j = json::parse(text.begin(), text.end());
   } catch (const json::parse_error& e) {
@@ -255,7 +269,8 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
 
   const json& levels = r.array(r.member(j, "", "levels"), "/levels", std::size_t(-1));
   if (levels.empty()) r.fail("/levels", "no level");
-  if (levels.size() > limits.max_levels) r.fail("/levels", "more than " + std::to_string(limits.max_levels) + " levels");
+  if (levels.size() > limits.max_levels) r.fail("/levels", std::to_string(levels.size()) + " levels exceed BundleLimits::max_levels (" +
+                                                                    std::to_string(limits.max_levels) + ")");
   std::set<std::string> files;
   for (std::size_t k = 0; k < levels.size(); ++k) {
     const std::string at = "/levels/" + std::to_string(k);
@@ -263,7 +278,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     r.only(lj, at, {"apl_count", "map_resolution", "position", "flux", "parent", "maps", "error_vs_distance"});
     BundleLevelInfo l;
     const std::size_t n = std::size_t(r.integer(r.member(lj, at, "apl_count"), at + "/apl_count", 1,
-                                                (long long)limits.max_apls_per_level));
+                                                (long long)limits.max_apls_per_level, "BundleLimits::max_apls_per_level"));
     if (k > 0 && n <= m.levels.back().apl_count())
       r.fail(at + "/apl_count", "does not exceed the previous level's " + std::to_string(m.levels.back().apl_count()));
     l.map_resolution = int(r.integer(r.member(lj, at, "map_resolution"), at + "/map_resolution", 1, sphere_map::kMaxResolution));
@@ -301,7 +316,8 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
       if (!files.insert(payload.file).second) r.fail(mp + "/file", "\"" + payload.file + "\" is listed twice");
       const std::uint64_t decoded = std::uint64_t(n) * 2 * std::uint64_t(payload.resolution) * payload.resolution * nc * 4;
       if (decoded > limits.max_decoded_bytes)
-        r.fail(mp, "would decode to " + std::to_string(decoded) + " bytes, above the limit");
+        r.fail(mp, "would decode to " + std::to_string(decoded) + " bytes, above BundleLimits::max_decoded_bytes (" +
+                       std::to_string(limits.max_decoded_bytes) + ")");
       l.maps.push_back(payload);
     }
     if (const json* e = r.optional_member(lj, "error_vs_distance")) {
@@ -336,7 +352,8 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
       a.name = p.file.rfind(prefix, 0) == 0 ? p.file.substr(prefix.size()) : std::string();
       if (!is_attachment_name(a.name)) r.fail(at + "/file", "must be attachments/NAME with NAME of [A-Za-z0-9._-]");
       if (!files.insert(p.file).second) r.fail(at + "/file", "\"" + p.file + "\" is listed twice");
-      p.bytes = std::uint64_t(r.integer(r.member(list[i], at, "bytes"), at + "/bytes", 0, (long long)limits.max_payload_bytes));
+      p.bytes = std::uint64_t(r.integer(r.member(list[i], at, "bytes"), at + "/bytes", 0, (long long)limits.max_payload_bytes,
+                                        "BundleLimits::max_payload_bytes"));
       p.sha256 = r.string(r.member(list[i], at, "sha256"), at + "/sha256");
       if (p.sha256.size() != 64 || p.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
         r.fail(at + "/sha256", "not 64 lowercase hexadecimal digits");
@@ -375,7 +392,8 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     if (r.string(r.member(*vj, "/volume", "radiance_unit"), "/volume/radiance_unit") != unit)
       r.fail("/volume/radiance_unit", "must be \"" + unit + "\" for intensity in " + intensity);
     const std::uint64_t decoded = std::uint64_t(v.counts.x) * v.counts.y * v.counts.z * v.bands * v.bands * v.channels * 4;
-    if (decoded > limits.max_decoded_bytes) r.fail("/volume", "would decode to " + std::to_string(decoded) + " bytes");
+    if (decoded > limits.max_decoded_bytes) r.fail("/volume", "would decode to " + std::to_string(decoded) + " bytes, above BundleLimits::max_decoded_bytes (" +
+                                                               std::to_string(limits.max_decoded_bytes) + ")");
     m.volume = v;
   }
   return m;

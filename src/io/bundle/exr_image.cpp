@@ -16,6 +16,7 @@
 #include <half.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 
@@ -63,6 +64,42 @@ class MemoryIStream : public Imf::IStream {
   throw_at_field(file, field, message);
 }
 
+/// Walks the header's attributes before OpenEXR parses them: OpenEXR allocates (and clears) each attribute's
+/// declared size before it reads the value, so a 100-byte payload declaring a 2 GB attribute would cost
+/// 2 GB. Every size must fit in the bytes that follow; lumx writes single-part scanline images only.
+void check_exr_header(std::string_view b, const std::string& file) {
+  const auto u32 = [&](std::size_t at) {
+    return std::uint32_t(std::uint8_t(b[at])) | std::uint32_t(std::uint8_t(b[at + 1])) << 8 |
+           std::uint32_t(std::uint8_t(b[at + 2])) << 16 | std::uint32_t(std::uint8_t(b[at + 3])) << 24;
+  };
+  if (b.size() < 8 || u32(0) != 20000630u) throw_at_offset(file, 0, "OpenEXR", "not an OpenEXR image (magic number)");
+  const std::uint32_t flags = u32(4) & ~0xffu;
+  if (flags & ~0x400u)  // anything but long attribute names: tiled, deep or multi-part
+    throw_at_offset(file, 4, "OpenEXR", "not a single-part scanline image (version flags " + std::to_string(flags) + ")");
+  std::size_t at = 8;
+  const auto zero_terminated = [&](const char* what) {
+    const std::size_t end = b.find('\0', at);
+    if (end == std::string_view::npos || end - at > 255)
+      throw_at_offset(file, std::int64_t(at), "OpenEXR header", std::string(what) + " is not terminated");
+    const std::string_view s = b.substr(at, end - at);
+    at = end + 1;
+    return s;
+  };
+  for (int n = 0;; ++n) {
+    if (n > 1024) throw_at_offset(file, std::int64_t(at), "OpenEXR header", "more than 1024 attributes");
+    const std::string_view name = zero_terminated("attribute name");
+    if (name.empty()) return;
+    (void)zero_terminated("attribute type");
+    if (b.size() - at < 4) throw_at_offset(file, std::int64_t(at), "OpenEXR header", "ends inside an attribute");
+    const std::uint32_t size = u32(at);
+    if (size > b.size() - at - 4)
+      throw_at_offset(file, std::int64_t(at), "OpenEXR header",
+                      "attribute \"" + std::string(name) + "\" declares " + std::to_string(size) + " bytes, " +
+                          std::to_string(b.size() - at - 4) + " follow");
+    at += 4 + size;
+  }
+}
+
 }  // namespace
 
 std::string encode_exr(const ExrImage& image) {
@@ -101,6 +138,7 @@ struct ExrReader::Impl {
 ExrReader::ExrReader(std::string_view bytes, const std::string& file, int width, int height,
                      const std::vector<std::string>& channels)
     : impl_(nullptr), file_(file), width_(width), height_(height), channels_(channels) {
+  check_exr_header(bytes, file);
   try {
     impl_ = new Impl(bytes, file);
     const Imf::Header& header = impl_->file.header();

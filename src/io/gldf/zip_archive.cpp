@@ -40,8 +40,8 @@ ZipArchive::ZipArchive(const std::string& path, const GldfLimits& limits) : path
   const auto bytes = std::filesystem::file_size(path, ec);
   if (ec) throw_at_field(path, "file", "cannot read: " + ec.message());
   if (bytes > limits.max_archive_bytes)
-    throw_at_field(path, "file", std::to_string(bytes) + " bytes exceed the limit of " +
-                                     std::to_string(limits.max_archive_bytes));
+    throw_at_field(path, "file", std::to_string(bytes) + " bytes exceed GldfLimits::max_archive_bytes (" +
+                                     std::to_string(limits.max_archive_bytes) + ")");
   int err = 0;
   zip_t* z = zip_open(path.c_str(), ZIP_RDONLY | ZIP_CHECKCONS, &err);
   if (!z) {
@@ -56,7 +56,7 @@ ZipArchive::ZipArchive(const std::string& path, const GldfLimits& limits) : path
     const zip_int64_t n = zip_get_num_entries(z, 0);
     if (n < 0) throw_at_field(path, "ZIP", "cannot count the entries");
     if (static_cast<std::uint64_t>(n) > limits.max_entries)
-      throw_at_field(path, "ZIP", std::to_string(n) + " entries exceed the limit of " + std::to_string(limits.max_entries));
+      throw_at_field(path, "ZIP", std::to_string(n) + " entries exceed GldfLimits::max_entries (" + std::to_string(limits.max_entries) + ")");
     std::uint64_t total = 0;
     for (zip_uint64_t i = 0; i < static_cast<zip_uint64_t>(n); ++i) {
       zip_stat_t st;
@@ -71,17 +71,17 @@ ZipArchive::ZipArchive(const std::string& path, const GldfLimits& limits) : path
         throw_at_field(where, "entry", "refused: encrypted");
       if (!(st.valid & ZIP_STAT_SIZE)) throw_at_field(where, "entry size", "unknown");
       if (st.size > limits.max_entry_bytes)
-        throw_at_field(where, "entry size", "refused: " + std::to_string(st.size) + " bytes exceed the limit of " +
-                                                std::to_string(limits.max_entry_bytes));
+        throw_at_field(where, "entry size", "refused: " + std::to_string(st.size) + " bytes exceed GldfLimits::max_entry_bytes (" +
+                                                std::to_string(limits.max_entry_bytes) + ")");
       total += st.size;
       if (total > limits.max_total_bytes)
-        throw_at_field(where, "entry size", "refused: the entries add up to more than " +
-                                                std::to_string(limits.max_total_bytes) + " bytes");
+        throw_at_field(where, "entry size", "refused: the entries add up to more than GldfLimits::max_total_bytes (" +
+                                                std::to_string(limits.max_total_bytes) + ")");
       if (st.size > (1u << 20) && (st.valid & ZIP_STAT_COMP_SIZE) &&
           static_cast<double>(st.size) > limits.max_compression_ratio * static_cast<double>(std::max<zip_uint64_t>(st.comp_size, 1)))
         throw_at_field(where, "compression ratio",
                        "refused: " + std::to_string(st.size) + " bytes from " + std::to_string(st.comp_size) +
-                           " compressed (a zip bomb?)");
+                           " compressed, a ratio above GldfLimits::max_compression_ratio (a zip bomb?)");
       if (name.back() == '/') continue;  // a folder
       entries_.push_back({name, i, st.size});
       names_.push_back(name);

@@ -78,7 +78,7 @@ PhotometryFormat detect_format(const std::string& path, std::string_view head) {
 }
 
 Photometry read_photometry(const std::string& path, const ReadOptions& options) {
-  const std::string text = read_file_bounded(path, options.limits.max_file_bytes);
+  const std::string text = read_file_bounded(path, options.limits.max_file_bytes, "ReadLimits::max_file_bytes");
   ReadOptions opts = options;
   if (opts.base_dir.empty()) {
     const auto parent = std::filesystem::path(path).parent_path();

@@ -53,8 +53,7 @@ bool is_tilt_line(std::string_view line, std::string_view& value) {
 TiltTable read_tilt_block(NumberStream& in, const ReadLimits& limits) {
   TiltTable t;
   t.lamp_geometry = static_cast<int>(in.next_integer("TILT lamp-to-luminaire geometry", 1, 3));
-  const long n = in.next_integer("TILT number of angle/multiplier pairs", 1,
-                                 static_cast<long>(limits.max_angles));
+  const long n = in.next_count("TILT number of angle/multiplier pairs", 1, limits.max_angles, "ReadLimits::max_angles");
   in.require_remaining(static_cast<std::size_t>(2 * n), "TILT angles and multipliers");
   t.angles_deg = in.next_values(static_cast<std::size_t>(n), "TILT angle", nullptr);
   t.multipliers = in.next_values(static_cast<std::size_t>(n), "TILT multiplier", nullptr);
@@ -93,8 +92,8 @@ std::string version_of_first_line(std::string_view first, bool& has_version_line
 Photometry read_ies(std::string_view text, const std::string& name, const ReadOptions& options) {
   if (text.size() > options.limits.max_file_bytes)
     throw Error(Diagnostic{Severity::error, name, 0, 0, "file size",
-                           "file is " + std::to_string(text.size()) + " bytes, above the limit of " +
-                               std::to_string(options.limits.max_file_bytes)});
+                           "file is " + std::to_string(text.size()) + " bytes, above ReadLimits::max_file_bytes (" +
+                               std::to_string(options.limits.max_file_bytes) + ")"});
   const NumberStream::Warn warn = [&](int line, const std::string& field, const std::string& msg) {
     if (options.warnings) options.warnings(Diagnostic{Severity::warning, name, line, -1, field, msg});
   };
@@ -210,9 +209,9 @@ Photometry read_ies(std::string_view text, const std::string& name, const ReadOp
   const double lumens = in.next_number("lumens per lamp");
   const double multiplier = in.next_number("candela multiplier");
   if (!(multiplier > 0)) in.fail_at_last("candela multiplier", "must be positive");
-  const long nv = in.next_integer("number of vertical angles", 1, static_cast<long>(options.limits.max_angles));
+  const long nv = in.next_count("number of vertical angles", 1, options.limits.max_angles, "ReadLimits::max_angles");
   if (nv < 2) in.fail_at_last("number of vertical angles", "at least 2 vertical angles are needed");
-  const long nh = in.next_integer("number of horizontal angles", 1, static_cast<long>(options.limits.max_angles));
+  const long nh = in.next_count("number of horizontal angles", 1, options.limits.max_angles, "ReadLimits::max_angles");
   const long type = in.next_integer("photometric type", 1, 3);
   const long units = in.next_integer("units type", 1, 2);
   const double width = in.next_number("luminous opening width");

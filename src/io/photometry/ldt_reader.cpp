@@ -39,6 +39,14 @@ namespace {
 constexpr int kMaxCPlanes = 721;
 constexpr int kMaxGamma = 361;
 
+/// Which bound an out-of-range count met: the format's own, or the embedder's option (named, so that it
+/// knows what to raise).
+std::string limit_source(std::size_t format_bound, std::size_t option, const char* option_name,
+                         const char* fixed = "the EULUMDAT maximum") {
+  return option < format_bound ? std::string(" (") + option_name + " is " + std::to_string(option) + ")"
+                               : std::string(" (") + fixed + ")";
+}
+
 // Header line numbers (1-based) of the fixed fields.
 enum HeaderLine : int {
   kCompany = 1, kItyp = 2, kIsym = 3, kMc = 4, kDc = 5, kNg = 6, kDg = 7,
@@ -208,8 +216,8 @@ Photometry LdtParser::parse() {
     d.file = name_;
     d.byte_offset = static_cast<std::int64_t>(opt_.limits.max_file_bytes);
     d.field = "file size";
-    d.message = "file of " + std::to_string(text_.size()) + " bytes exceeds the limit of " +
-                std::to_string(opt_.limits.max_file_bytes) + " bytes";
+    d.message = "file of " + std::to_string(text_.size()) + " bytes exceeds ReadLimits::max_file_bytes (" +
+                std::to_string(opt_.limits.max_file_bytes) + ")";
     throw Error(std::move(d));
   }
 
@@ -238,13 +246,15 @@ Photometry LdtParser::parse() {
   const int mc = int_field(kMc, "Mc");
   const int mc_limit = static_cast<int>(std::min<std::size_t>(kMaxCPlanes, opt_.limits.max_angles));
   if (mc < 1 || mc > mc_limit)
-    fail(kMc, "Mc", "number of C-planes " + std::to_string(mc) + " is outside 1.." + std::to_string(mc_limit));
+    fail(kMc, "Mc", "number of C-planes " + std::to_string(mc) + " is outside 1.." + std::to_string(mc_limit) +
+                        limit_source(kMaxCPlanes, opt_.limits.max_angles, "ReadLimits::max_angles"));
   const double dc = real_field(kDc, "Dc");
   if (dc < 0) fail(kDc, "Dc", "C-plane spacing " + fmt(dc) + " is negative");
   const int ng = int_field(kNg, "Ng");
   const int ng_limit = static_cast<int>(std::min<std::size_t>(kMaxGamma, opt_.limits.max_angles));
   if (ng < 2 || ng > ng_limit)  // one gamma angle describes no solid angle: no flux, no interpolation
-    fail(kNg, "Ng", "number of gamma angles " + std::to_string(ng) + " is outside 2.." + std::to_string(ng_limit));
+    fail(kNg, "Ng", "number of gamma angles " + std::to_string(ng) + " is outside 2.." + std::to_string(ng_limit) +
+                        limit_source(kMaxGamma, opt_.limits.max_angles, "ReadLimits::max_angles"));
   const double dg = real_field(kDg, "Dg");
   if (dg < 0) fail(kDg, "Dg", "gamma spacing " + fmt(dg) + " is negative");
 
@@ -306,7 +316,8 @@ Photometry LdtParser::parse() {
   const int sets_limit = static_cast<int>(std::min<std::size_t>(opt_.limits.max_lamp_sets, 100000));
   if (nsets < 1 || nsets > sets_limit)
     fail(kLampSetCount, "number of lamp sets",
-         std::to_string(nsets) + " lamp sets is outside 1.." + std::to_string(sets_limit));
+         std::to_string(nsets) + " lamp sets is outside 1.." + std::to_string(sets_limit) +
+             limit_source(100000, opt_.limits.max_lamp_sets, "ReadLimits::max_lamp_sets", "lumx's fixed bound"));
 
   // ---- lamp sets, 6 lines each ----
   double sum_flux = 0, sum_watts = 0;

@@ -60,11 +60,13 @@ class Tm33Parser {
       }
     fail(n, n.name + "@" + name, std::string("attribute '") + name + "' is missing");
   }
-  long integer(const Tm33Node& n, long lo, long hi) const {
+  /// `limit_name` names the option `hi` comes from, if it does ("ReadLimits::max_angles").
+  long integer(const Tm33Node& n, long lo, long hi, const char* limit_name = nullptr) const {
     const double v = number(n);
     if (v != std::floor(v) || v < static_cast<double>(lo) || v > static_cast<double>(hi))
       fail(n, n.name, "'" + detail::excerpt(detail::trim_space(n.text)) + "' is not an integer in " + std::to_string(lo) +
-                          ".." + std::to_string(hi));
+                          ".." + std::to_string(hi) +
+                          (limit_name && v > static_cast<double>(hi) ? std::string(" (") + limit_name + ")" : ""));
     return static_cast<long>(v);
   }
   bool boolean(const Tm33Node& n) const {
@@ -140,9 +142,9 @@ void Tm33Parser::read_intensity(Photometry& p, const Tm33Node& li, double rated_
   std::vector<const Tm33Node*> data;
   for (const auto& c : li.children) {
     if (c.name == "IntData") data.push_back(&c);
-    else if (c.name == "NumberHorz") nh_decl = integer(c, 1, static_cast<long>(max_angles));
-    else if (c.name == "NumberVert") nv_decl = integer(c, 1, static_cast<long>(max_angles));
-    else if (c.name == "NumberMeasured") nm_decl = integer(c, 1, static_cast<long>(max_angles * max_angles));
+    else if (c.name == "NumberHorz") nh_decl = integer(c, 1, static_cast<long>(max_angles), "ReadLimits::max_angles");
+    else if (c.name == "NumberVert") nv_decl = integer(c, 1, static_cast<long>(max_angles), "ReadLimits::max_angles");
+    else if (c.name == "NumberMeasured") nm_decl = integer(c, 1, static_cast<long>(max_angles * max_angles), "ReadLimits::max_angles squared");
     else if (c.name == "Multiplier") {
       multiplier = number(c);
       if (!(multiplier > 0)) fail(c, c.name, "must be positive");
@@ -171,8 +173,8 @@ void Tm33Parser::read_intensity(Photometry& p, const Tm33Node& li, double rated_
   };
   unique_sorted(hs);
   unique_sorted(vs);
-  if (hs.size() > max_angles) fail(li, "IntData@h", std::to_string(hs.size()) + " horizontal angles exceed the limit of " + std::to_string(max_angles));
-  if (vs.size() > max_angles) fail(li, "IntData@v", std::to_string(vs.size()) + " vertical angles exceed the limit of " + std::to_string(max_angles));
+  if (hs.size() > max_angles) fail(li, "IntData@h", std::to_string(hs.size()) + " horizontal angles exceed ReadLimits::max_angles (" + std::to_string(max_angles) + ")");
+  if (vs.size() > max_angles) fail(li, "IntData@v", std::to_string(vs.size()) + " vertical angles exceed ReadLimits::max_angles (" + std::to_string(max_angles) + ")");
   if (nh_decl && static_cast<std::size_t>(*nh_decl) != hs.size())
     fail(*li.child("NumberHorz"), "NumberHorz", "states " + std::to_string(*nh_decl) + " horizontal angles but IntData has " + std::to_string(hs.size()));
   if (nv_decl && static_cast<std::size_t>(*nv_decl) != vs.size())
@@ -269,9 +271,9 @@ void Tm33Parser::read_emitter(Photometry& p, const Tm33Node& e, std::size_t inde
       TiltTable t;
       std::optional<long> declared;
       for (const auto& a : c.children) {
-        if (a.name == "NumberAngles") declared = integer(a, 1, static_cast<long>(opt_.limits.max_angles));
+        if (a.name == "NumberAngles") declared = integer(a, 1, static_cast<long>(opt_.limits.max_angles), "ReadLimits::max_angles");
         else if (a.name == "Tilt") {
-          if (t.angles_deg.size() >= opt_.limits.max_angles) fail(a, "Tilt", "more tilt angles than the limit");
+          if (t.angles_deg.size() >= opt_.limits.max_angles) fail(a, "Tilt", "more tilt angles than ReadLimits::max_angles (" + std::to_string(opt_.limits.max_angles) + ")");
           t.angles_deg.push_back(attribute_number(a, "angle"));
           t.multipliers.push_back(number(a));
         }
@@ -442,7 +444,7 @@ Photometry Tm33Parser::parse(const Tm33Node& root) {
       num_emitter = c.child("NumEmitter");
     } else if (c.name == "Emitter") {
       if (emitters >= opt_.limits.max_lamp_sets)
-        fail(c, "Emitter", "more than " + std::to_string(opt_.limits.max_lamp_sets) + " emitters");
+        fail(c, "Emitter", "more emitters than ReadLimits::max_lamp_sets (" + std::to_string(opt_.limits.max_lamp_sets) + ")");
       read_emitter(p, c, emitters++);
     } else if (c.name == "CustomData") {
       const Tm33Node* id = c.child("UniqueIdentifier");
@@ -496,13 +498,13 @@ Photometry read_tree(const detail::Tm33Node& root, const std::string& name, cons
 
 Photometry read_tm33_xml(std::string_view text, const std::string& name, const ReadOptions& options) {
   if (text.size() > options.limits.max_file_bytes)
-    throw_at_field(name, "file", "larger than the limit of " + std::to_string(options.limits.max_file_bytes) + " bytes");
+    throw_at_field(name, "file", std::to_string(text.size()) + " bytes, above ReadLimits::max_file_bytes (" + std::to_string(options.limits.max_file_bytes) + ")");
   return read_tree(detail::parse_tm33_xml_tree(text, name), name, options, false);
 }
 
 Photometry read_tm33_json(std::string_view text, const std::string& name, const ReadOptions& options) {
   if (text.size() > options.limits.max_file_bytes)
-    throw_at_field(name, "file", "larger than the limit of " + std::to_string(options.limits.max_file_bytes) + " bytes");
+    throw_at_field(name, "file", std::to_string(text.size()) + " bytes, above ReadLimits::max_file_bytes (" + std::to_string(options.limits.max_file_bytes) + ")");
   return read_tree(detail::parse_tm33_json_tree(text, name), name, options, true);
 }
 

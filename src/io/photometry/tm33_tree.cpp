@@ -2,6 +2,7 @@
 // Copyright Contributors to the lumx project.
 // The TM-33 element tree: XML via libxml2, the JSON form via nlohmann-json, both located (tm33_tree.h).
 #include "io/photometry/tm33_tree.h"
+#include "io/json_depth.h"
 
 #include "io/text_scanner.h"
 
@@ -275,6 +276,9 @@ Tm33Node parse_tm33_xml_tree(std::string_view text, const std::string& file) {
 
 Tm33Node parse_tm33_json_tree(std::string_view text, const std::string& file) {
   ojson j;
+  if (const std::size_t at = detail::json_too_deep_at(text); at != std::string_view::npos)
+    throw_at_line(file, 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n')), "JSON",
+                  "nested more than " + std::to_string(detail::kMaxJsonDepth) + " levels deep");
   try {
     j = ojson::parse(text.begin(), text.end());
   } catch (const ojson::parse_error& e) {

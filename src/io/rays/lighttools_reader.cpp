@@ -111,6 +111,10 @@ std::unique_ptr<RaySource> open_lighttools_binary(std::shared_ptr<const RayFile>
   info.format = "LightTools binary";
   info.version = std::to_string(major) + "." + std::to_string(minor);
   info.ray_count = data / rec;
+  if (info.ray_count > o.limits.max_rays)
+    throw_at_offset(path, static_cast<std::int64_t>(kHeader), "ray data",
+                    std::to_string(info.ray_count) + " rays exceed RaysetLimits::max_rays (" +
+                        std::to_string(o.limits.max_rays) + ")");
   info.quantity = type == 1 ? PhotometricQuantity::photometric : PhotometricQuantity::radiometric;
   info.header_flux = total;
   info.source_length_unit = unit_code == 0 ? "system (" + unit->name + " assumed)" : unit->name;
@@ -149,7 +153,7 @@ std::unique_ptr<RaySource> open_lighttools_text(std::shared_ptr<const RayFile> f
   while (lines.next(line)) {
     if (++header_lines > o.limits.max_header_lines)
       throw_at_line(path, lines.line_number(), "header",
-                    "no lt_startofdata within " + std::to_string(o.limits.max_header_lines) + " lines");
+                    "no lt_startofdata within RaysetLimits::max_header_lines (" + std::to_string(o.limits.max_header_lines) + ")");
     const std::string_view t = trim_blanks(line);
     if (t.empty()) continue;
     if (t.front() == '#') {
@@ -257,6 +261,7 @@ std::unique_ptr<RaySource> open_lighttools_text(std::shared_ptr<const RayFile> f
   l.unit = *unit;
   l.end_marker = "lt_endofdata";
   l.max_line_bytes = o.limits.max_line_bytes;
+  l.max_rays = o.limits.max_rays;
   l.flux_line = flux_line;
   l.flux_field = flux_key.empty() ? "total flux" : flux_key;
   info.ray_count = count_text_rays(f, l, o.warnings);

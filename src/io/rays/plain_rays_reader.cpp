@@ -78,6 +78,7 @@ std::unique_ptr<RaySource> open_plain_rays(std::shared_ptr<const RayFile> file, 
   l.header_lines = lines.line_number();
   l.hash_comments = true;
   l.max_line_bytes = o.limits.max_line_bytes;
+  l.max_rays = o.limits.max_rays;
   l.unit = *unit;
   l.flux_line = header_line;
   l.flux_field = "total";

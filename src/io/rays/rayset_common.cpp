@@ -291,7 +291,7 @@ bool LineReader::next(std::string_view& line) {
     while (k < n && b[k] != '\n' && b[k] != '\r') ++k;
     if (k > max_line_)
       throw_at_line(file_.path(), line_ + 1, "line",
-                    "line is longer than the limit of " + std::to_string(max_line_) + " bytes");
+                    "line is longer than RaysetLimits::max_line_bytes (" + std::to_string(max_line_) + ")");
     bool have = false;
     std::size_t term = 0;
     if (k < n) {

@@ -286,6 +286,7 @@ struct TextRayLayout {
   std::string end_marker;      ///< a line that ends the data ("lt_endofdata"), or empty (end of file)
   bool hash_comments = false;  ///< lines starting with '#' are comments
   std::size_t max_line_bytes = 64u << 10;
+  std::uint64_t max_rays = ~std::uint64_t(0);  ///< RaysetLimits::max_rays
   int flux_line = 0;  ///< where the header states the total flux
   std::string flux_field = "total flux";
 };

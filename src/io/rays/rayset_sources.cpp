@@ -186,7 +186,9 @@ std::uint64_t count_text_rays(const RayFile& file, const TextRayLayout& layout, 
       ended = true;
       continue;
     }
-    ++n;
+    if (++n > layout.max_rays)
+      throw_at_line(file.path(), lines.line_number(), "ray data",
+                    "more rays than RaysetLimits::max_rays (" + std::to_string(layout.max_rays) + ")");
   }
   if (!layout.end_marker.empty() && !ended)
     throw_at_line(file.path(), std::max(1, lines.line_number()), "end of data",

@@ -66,7 +66,7 @@ class Tm25Header {
     if (rays == 0) warn(warning_at_offset(file, 20, "number of rays (4.7.1.6)", "the file holds no rays"));
     if (rays > o_.limits.max_rays)
       throw_at_offset(file, 20, "number of rays (4.7.1.6)",
-                      std::to_string(rays) + " rays exceed the limit of " + std::to_string(o_.limits.max_rays));
+                      std::to_string(rays) + " rays exceed RaysetLimits::max_rays (" + std::to_string(o_.limits.max_rays) + ")");
     need(28, 28, "creation date (4.7.1.7)");
     std::string date;
     for (int i = 0; i < 28 && buf_[28 + i] != 0; ++i) date += static_cast<char>(buf_[28 + i]);
@@ -107,15 +107,15 @@ class Tm25Header {
     if (static_cast<std::size_t>(n_spectra) > o_.limits.max_spectral_tables)
       throw_at_offset(
           file, 76, "number of spectral tables (4.7.1.13)",
-          std::to_string(n_spectra) + " tables exceed the limit of " + std::to_string(o_.limits.max_spectral_tables));
+          std::to_string(n_spectra) + " tables exceed RaysetLimits::max_spectral_tables (" + std::to_string(o_.limits.max_spectral_tables) + ")");
     const std::int32_t n_additional = i32(80, "number of additional items (4.7.1.14)");
     if (n_additional < 0)
       throw_at_offset(file, 80, "number of additional items (4.7.1.14)",
                       "is negative (" + std::to_string(n_additional) + ")");
     if (static_cast<std::size_t>(n_additional) > o_.limits.max_additional_items)
       throw_at_offset(file, 80, "number of additional items (4.7.1.14)",
-                      std::to_string(n_additional) + " columns exceed the limit of " +
-                          std::to_string(o_.limits.max_additional_items));
+                      std::to_string(n_additional) + " columns exceed RaysetLimits::max_additional_items (" +
+                          std::to_string(o_.limits.max_additional_items) + ")");
     const std::int32_t text_size = i32(84, "additional text size (4.7.1.15)");
     if (text_size < 0 || text_size % 32 != 0)
       throw_at_offset(file, 84, "additional text size (4.7.1.15)",
@@ -123,7 +123,7 @@ class Tm25Header {
     if (static_cast<std::size_t>(text_size) > o_.limits.max_text_bytes)
       throw_at_offset(
           file, 84, "additional text size (4.7.1.15)",
-          std::to_string(text_size) + " bytes exceed the limit of " + std::to_string(o_.limits.max_text_bytes));
+          std::to_string(text_size) + " bytes exceed RaysetLimits::max_text_bytes (" + std::to_string(o_.limits.max_text_bytes) + ")");
     need(88, 168, "reserved (4.7.1.16)");
 
     // 4.7.2 known data flags
@@ -200,7 +200,7 @@ class Tm25Header {
       points += static_cast<std::size_t>(np);
       if (points > o_.limits.max_spectral_points)
         throw_at_offset(file, static_cast<std::int64_t>(off), field,
-                        "more than " + std::to_string(o_.limits.max_spectral_points) + " spectral points in all");
+                        "more spectral points in all than RaysetLimits::max_spectral_points (" + std::to_string(o_.limits.max_spectral_points) + ")");
       const std::uint64_t bytes = 8 * static_cast<std::uint64_t>(np);
       if (off + 4 + bytes > f_.size())
         throw_at_offset(file, static_cast<std::int64_t>(off), field,

@@ -37,6 +37,9 @@ std::unique_ptr<RaySource> open_zemax_binary(std::shared_ptr<const RayFile> file
     throw_at_offset(path, 0, "format identifier", "must be 1010 (Zemax binary source file), is " + std::to_string(id));
   need(4, 4, "number of rays");
   const std::uint32_t rays = le_u32(h + 4);
+  if (rays > o.limits.max_rays)
+    throw_at_offset(path, 4, "number of rays",
+                    std::to_string(rays) + " rays exceed RaysetLimits::max_rays (" + std::to_string(o.limits.max_rays) + ")");
   need(8, 100, "description");
   std::string description;
   for (int i = 0; i < 100 && h[8 + i] != 0; ++i) description += static_cast<char>(h[8 + i]);
@@ -153,8 +156,11 @@ std::unique_ptr<RaySource> open_zemax_text(std::shared_ptr<const RayFile> file, 
   if (values.size() < 2)
     throw_at_line(path, header_line, "header", "the first line must hold the ray count and the dimension-unit code");
   const double count = values[0];
-  if (!(count >= 0 && count == std::floor(count) && count <= static_cast<double>(o.limits.max_rays)))
+  if (!(count >= 0 && count == std::floor(count)))
     throw_at_line(path, header_line, "number of rays", "'" + format_number_9(count) + "' is not a ray count");
+  if (count > static_cast<double>(o.limits.max_rays))
+    throw_at_line(path, header_line, "number of rays",
+                  format_number_9(count) + " rays exceed RaysetLimits::max_rays (" + std::to_string(o.limits.max_rays) + ")");
   const double code = values[1];
   const auto unit = code == std::floor(code) ? zemax_unit(static_cast<std::int64_t>(code)) : std::nullopt;
   if (!unit)
@@ -164,6 +170,7 @@ std::unique_ptr<RaySource> open_zemax_text(std::shared_ptr<const RayFile> file, 
   l.data_offset = lines.offset();
   l.header_lines = header_line;
   l.max_line_bytes = o.limits.max_line_bytes;
+  l.max_rays = o.limits.max_rays;
   // Columns from the first ray line: 7 (flux only) or 8 (with wavelength in µm).
   std::size_t cols = 7;
   while (lines.next(line)) {
