@@ -5,6 +5,8 @@
 // roulette in the reference) and the pixel loop in passes.
 #include <lumx/render/appearance.h>
 
+#include "bake/path_state.h"
+
 #include <lumx/bake/bsdf.h>
 #include <lumx/bake/random.h>
 #include <lumx/core/diagnostic.h>
@@ -42,39 +44,8 @@ namespace {
 double max_component(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-/// Orthonormal basis around unit n (Duff et al. 2017, JCGT 6(1)), as the tracer uses.
-struct Frame {
-  glm::dvec3 s, t, n;
-  explicit Frame(const glm::dvec3& normal) : n(normal) {
-    const double sign = std::copysign(1.0, n.z);
-    const double a = -1.0 / (sign + n.z);
-    const double b = n.x * n.y * a;
-    s = {1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x};
-    t = {b, sign + n.y * n.y * a, -n.y};
-  }
-  glm::dvec3 to_local(const glm::dvec3& v) const { return {glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)}; }
-  glm::dvec3 to_world(const glm::dvec3& v) const { return v.x * s + v.y * t + v.z * n; }
-};
-
-/// The solids an eye path is inside, innermost on top (nested glass).
-struct MediumStack {
-  static constexpr int kCapacity = 8;
-  std::uint32_t part[kCapacity];
-  int size = 0;
-  void push(std::uint32_t p) {
-    if (size < kCapacity) part[size++] = p;
-  }
-  void remove(std::uint32_t p) {
-    for (int i = size - 1; i >= 0; --i)
-      if (part[i] == p) {
-        for (int j = i; j + 1 < size; ++j) part[j] = part[j + 1];
-        --size;
-        return;
-      }
-  }
-  bool empty() const { return size == 0; }
-  std::uint32_t top() const { return part[size - 1]; }
-};
+using bake::detail::Frame;
+using bake::detail::MediumStack;
 
 /// Power heuristic with β = 2 (Veach 1997 §9.2.4).
 double power_heuristic(double pdf_a, double pdf_b) {

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// src/bake/path_state.h — what a path through a luminaire carries from one hit to the next, shared by the
+// particle tracer (bake/tracer.cpp) and the eye paths of the appearance renderer (render/appearance.cpp):
+// the shading frame at a hit and the stack of solids the path is inside.
+#pragma once
+
+#include <lumx/version.h>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include <cmath>
+#include <cstdint>
+
+LUMX_NAMESPACE_BEGIN
+namespace bake::detail {
+
+/// Orthonormal basis around unit n (Duff et al. 2017, "Building an Orthonormal Basis, Revisited", JCGT 6(1)).
+struct Frame {
+  glm::dvec3 s, t, n;
+  explicit Frame(const glm::dvec3& normal) : n(normal) {
+    const double sign = std::copysign(1.0, n.z);
+    const double a = -1.0 / (sign + n.z);
+    const double b = n.x * n.y * a;
+    s = {1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x};
+    t = {b, sign + n.y * n.y * a, -n.y};
+  }
+  glm::dvec3 to_local(const glm::dvec3& v) const { return {glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)}; }
+  glm::dvec3 to_world(const glm::dvec3& v) const { return v.x * s + v.y * t + v.z * n; }
+};
+
+/// The volume parts a path is inside, innermost on top (nested solids: a bulb inside a glass globe).
+struct MediumStack {
+  static constexpr int kCapacity = 8;
+  std::uint32_t part[kCapacity];
+  int size = 0;
+  void push(std::uint32_t p) {
+    if (size < kCapacity) part[size++] = p;
+  }
+  void remove(std::uint32_t p) {
+    for (int i = size - 1; i >= 0; --i)
+      if (part[i] == p) {
+        for (int j = i; j + 1 < size; ++j) part[j] = part[j + 1];
+        --size;
+        return;
+      }
+  }
+  bool empty() const { return size == 0; }
+  std::uint32_t top() const { return part[size - 1]; }
+};
+
+}  // namespace bake::detail
+LUMX_NAMESPACE_END
