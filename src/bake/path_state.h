@@ -11,7 +11,9 @@
 #include <glm/vec3.hpp>
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 LUMX_NAMESPACE_BEGIN
 namespace bake::detail {
@@ -49,6 +51,22 @@ struct MediumStack {
   bool empty() const { return size == 0; }
   std::uint32_t top() const { return part[size - 1]; }
 };
+
+/// The unit shading normal at barycentrics (u, v) of triangle `tri`: its vertex normals (3 per triangle in
+/// `triangle_normals`, empty for flat shading) interpolated, and turned to the side of the unit geometric
+/// normal `ng` when they point against the winding (the winding's side is trusted); `ng` itself when there
+/// are none or they cancel.
+inline glm::dvec3 shading_normal(const glm::dvec3& ng, const std::vector<glm::vec3>& triangle_normals, std::size_t tri,
+                                 double u, double v) {
+  if (triangle_normals.empty()) return ng;
+  const glm::dvec3 interpolated = (1.0 - u - v) * glm::dvec3(triangle_normals[3 * tri]) +
+                                  u * glm::dvec3(triangle_normals[3 * tri + 1]) +
+                                  v * glm::dvec3(triangle_normals[3 * tri + 2]);
+  const double len = glm::length(interpolated);
+  glm::dvec3 ns = len > 0.0 && std::isfinite(len) ? interpolated / len : ng;
+  if (glm::dot(ns, ng) < 0.0) ns = -ns;
+  return ns;
+}
 
 }  // namespace bake::detail
 LUMX_NAMESPACE_END

@@ -43,6 +43,7 @@ double max_component(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 
 using detail::Frame;
 using detail::MediumStack;
+using detail::shading_normal;
 
 }  // namespace
 
@@ -293,16 +294,7 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
       continue;
     }
     ng /= ng_len;
-    glm::dvec3 ns = ng;
-    if (!triangle_normals.empty()) {
-      const double u = rh.hit.u, v = rh.hit.v;
-      const glm::dvec3 interpolated = (1.0 - u - v) * glm::dvec3(triangle_normals[3 * tri]) +
-                                      u * glm::dvec3(triangle_normals[3 * tri + 1]) +
-                                      v * glm::dvec3(triangle_normals[3 * tri + 2]);
-      const double len = glm::length(interpolated);
-      if (len > 0.0 && std::isfinite(len)) ns = interpolated / len;
-      if (glm::dot(ns, ng) < 0.0) ns = -ns;  // normals against the winding: trust the winding's side
-    }
+    glm::dvec3 ns = shading_normal(ng, triangle_normals, tri, rh.hit.u, rh.hit.v);
 
     const glm::dvec3 wo = -direction;
     const bool front = glm::dot(wo, ng) > 0.0;

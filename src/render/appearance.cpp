@@ -46,6 +46,7 @@ bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v
 
 using bake::detail::Frame;
 using bake::detail::MediumStack;
+using bake::detail::shading_normal;
 
 /// Power heuristic with β = 2 (Veach 1997 §9.2.4).
 double power_heuristic(double pdf_a, double pdf_b) {
@@ -358,16 +359,7 @@ struct AppearanceRenderer::Impl {
         continue;
       }
       ng /= ng_len;
-      glm::dvec3 ns = ng;
-      if (!triangle_normals.empty()) {
-        const double u = rh.hit.u, v = rh.hit.v;
-        const glm::dvec3 interpolated = (1.0 - u - v) * glm::dvec3(triangle_normals[3 * tri]) +
-                                        u * glm::dvec3(triangle_normals[3 * tri + 1]) +
-                                        v * glm::dvec3(triangle_normals[3 * tri + 2]);
-        const double len = glm::length(interpolated);
-        if (len > 0.0 && std::isfinite(len)) ns = interpolated / len;
-        if (glm::dot(ns, ng) < 0.0) ns = -ns;
-      }
+      glm::dvec3 ns = shading_normal(ng, triangle_normals, tri, rh.hit.u, rh.hit.v);
       const glm::dvec3 wo = -direction;
       const bool front = glm::dot(wo, ng) > 0.0;
 
