@@ -80,21 +80,39 @@ bool half_keeps_flux(const std::vector<const SphereMap*>& maps) {
   return true;
 }
 
-BundlePayload write_payload(const std::string& folder, const std::string& relative, const detail::ExrImage& image) {
+/// Writes one file of a bundle being assembled in the scratch folder `folder`. A failure names the file as
+/// part of `bundle`, the path the caller asked for, not the scratch folder that is about to be removed.
+void write_scratch_file(const std::string& folder, const std::string& relative, std::string_view bytes,
+                        const std::string& bundle) {
+  try {
+    write_file_atomically(join(folder, relative), bytes);
+  } catch (const Error& e) {
+    fail(bundle + "/" + relative, e.diagnostic().field, e.diagnostic().message);
+  }
+}
+
+BundlePayload write_payload(const std::string& folder, const std::string& relative, const detail::ExrImage& image,
+                            const std::string& bundle) {
   BundlePayload p;
   p.file = relative;
   const std::string bytes = detail::encode_exr(image);
   p.bytes = bytes.size();
   p.sha256 = detail::sha256_hex(bytes);
   p.pixel_type = image.half ? "half" : "float";
-  write_file_atomically(join(folder, relative), bytes);
+  write_scratch_file(folder, relative, bytes, bundle);
   return p;
 }
 
-void fsync_folder(const std::string& folder) {
+/// Makes the folder's entries durable. A file system that cannot sync folders (EINVAL) is not an error;
+/// any other failure is, located at `bundle` (the path the caller asked for).
+void fsync_folder(const std::string& folder, const std::string& bundle) {
   const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return;
-  ::fsync(fd);  // best effort: some file systems refuse to sync folders (EINVAL)
+  if (fd < 0) fail(bundle, "file", std::string("open folder for fsync: ") + std::strerror(errno));
+  if (::fsync(fd) != 0 && errno != EINVAL) {
+    const int err = errno;
+    ::close(fd);
+    fail(bundle, "file", std::string("fsync folder: ") + std::strerror(err));
+  }
   ::close(fd);
 }
 
@@ -217,7 +235,7 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
         std::snprintf(name, sizeof name, "levels/level%02zu_n%05zu_r%04d.exr", k, level.apls.size(), R);
         image.half = choose_half(max_value, options.pixel_type, path + "/" + name);
         if (image.half && options.pixel_type == MapPixelType::automatic && !half_keeps_flux(maps)) image.half = false;
-        BundlePayload p = write_payload(tmp, name, image);
+        BundlePayload p = write_payload(tmp, name, image, path);
         p.resolution = R;
         info.maps.push_back(p);
         if (options.min_stored_resolution <= 0 || R % 2 != 0 || R / 2 < options.min_stored_resolution) break;
@@ -245,7 +263,7 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
       image.pixels = volume->coefficients();
       for (float c : image.pixels)
         if (!std::isfinite(c)) fail(path, "volume", "a coefficient is not finite");
-      v.payload = write_payload(tmp, "volume.exr", image);
+      v.payload = write_payload(tmp, "volume.exr", image, path);
       m.volume = v;
     }
     if (!options.attachments.empty()) fs::create_directories(fs::path(tmp) / "attachments");
@@ -257,15 +275,15 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
       p.file = "attachments/" + a.name;
       p.bytes = a.bytes.size();
       p.sha256 = detail::sha256_hex(a.bytes);
-      write_file_atomically(join(tmp, p.file), a.bytes);
+      write_scratch_file(tmp, p.file, a.bytes, path);
       m.attachments.emplace_back(BundleAttachment{a.name, a.media_type, {}}, p);
     }
     // The writer's output must be what its reader accepts: parse it back before anything is replaced.
     const std::string manifest_text = detail::manifest_to_json(m);
     detail::parse_manifest(manifest_text, path + "/" + bundle::kManifestName, BundleLimits{});
-    write_file_atomically(join(tmp, bundle::kManifestName), manifest_text);
-    fsync_folder(tmp + "/levels");
-    fsync_folder(tmp);
+    write_scratch_file(tmp, bundle::kManifestName, manifest_text, path);
+    fsync_folder(tmp + "/levels", path);
+    fsync_folder(tmp, path);
 
     if (exists) {
       swap_in(tmp, target, path);  // the old bundle is now at tmp
@@ -273,7 +291,8 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
     } else if (::rename(tmp.c_str(), target.c_str()) != 0) {
       fail(path, "rename", std::string("cannot move the new bundle in place: ") + std::strerror(errno));
     }
-    fsync_folder(target.parent_path().string());
+    // After the swap the new bundle is in place: a failure here is reported, and leaves it whole.
+    fsync_folder(target.parent_path().string(), path);
   } catch (const Error&) {
     fs::remove_all(tmp, ec);
     throw;

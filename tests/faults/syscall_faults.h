@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// System-call fault injection for the write tests (hard-cases.md §6 items 36–37). The test program defines
+// write, pwrite, fsync and close itself; the dynamic linker binds every call to them, the library's and the
+// C++ runtime's included, to these definitions, which forward to the C library's unless a fault is armed.
+// Only regular files opened for writing are counted and failed, so the test's own output is untouched.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace lumx_faults {
+
+enum class Call {
+  none,
+  write,            ///< write/pwrite fail once `at_byte` bytes were written in all (a short write first)
+  fsync_file,       ///< fsync of a regular file fails
+  fsync_directory,  ///< fsync of a folder fails
+  close_file,       ///< close of a regular file open for writing: the descriptor is released, then fails
+};
+
+struct Fault {
+  Call call = Call::none;
+  int error = 0;                 ///< errno to report, e.g. ENOSPC or EIO
+  std::uint64_t at_byte = 0;     ///< Call::write: bytes that succeed before the first failure
+  std::size_t max_chunk = 0;     ///< > 0: every write moves at most this many bytes (short writes), no failure
+};
+
+/// Arms `fault` and clears the counters; disarm() restores the C library's behaviour.
+void arm(const Fault& fault);
+void disarm();
+/// Bytes written to regular files since arm() (what succeeded, short writes included).
+std::uint64_t bytes_written();
+/// How many calls failed because of the armed fault.
+int failures_injected();
+
+/// Arms a fault for the lifetime of the object.
+struct Armed {
+  explicit Armed(const Fault& f) { arm(f); }
+  ~Armed() { disarm(); }
+  Armed(const Armed&) = delete;
+  Armed& operator=(const Armed&) = delete;
+};
+
+}  // namespace lumx_faults
