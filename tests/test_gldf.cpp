@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 
 using namespace lumx;
 namespace fs = std::filesystem;
@@ -33,8 +34,10 @@ std::vector<fs::path> shared_containers() {
   return out;
 }
 
-/// Writes a ZIP with the given entries (name, bytes), deflated.
-void write_zip(const fs::path& path, const std::vector<std::pair<std::string, std::string>>& entries) {
+/// Writes a ZIP with the given entries (name, bytes), deflated, or stored when `store` (so that the entry's
+/// bytes appear as they are in the archive).
+void write_zip(const fs::path& path, const std::vector<std::pair<std::string, std::string>>& entries,
+               bool store = false) {
   fs::remove(path);
   int err = 0;
   zip_t* z = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &err);
@@ -42,7 +45,11 @@ void write_zip(const fs::path& path, const std::vector<std::pair<std::string, st
   for (const auto& [name, bytes] : entries) {
     zip_source_t* s = zip_source_buffer(z, bytes.data(), bytes.size(), 0);
     ASSERT_NE(s, nullptr);
-    ASSERT_GE(zip_file_add(z, name.c_str(), s, ZIP_FL_ENC_UTF_8), 0) << name;
+    const zip_int64_t index = zip_file_add(z, name.c_str(), s, ZIP_FL_ENC_UTF_8);
+    ASSERT_GE(index, 0) << name;
+    if (store) {
+      ASSERT_EQ(zip_set_file_compression(z, static_cast<zip_uint64_t>(index), ZIP_CM_STORE, 0), 0);
+    }
   }
   ASSERT_EQ(zip_close(z), 0);
 }
@@ -195,5 +202,95 @@ TEST(Gldf, HostileArchivesAreRefusedBeforeExtraction) {
   EXPECT_EQ(error_of(p).field, "ZIP");
   write_zip(p, {{"ldc/a.ldt", ldt}});
   EXPECT_EQ(error_of(p).field, "product.xml");
+  fs::remove(p);
+}
+
+namespace {
+
+std::string read_bytes(const fs::path& p) { return lumx_test::read_text(p); }
+void write_bytes(const fs::path& p, const std::string& b) { std::ofstream(p, std::ios::binary | std::ios::trunc) << b; }
+
+/// Offset of the `n`-th occurrence (from 0) of `needle` in `bytes`; fails the test if there is none.
+std::size_t nth(const std::string& bytes, const std::string& needle, int n) {
+  std::size_t at = bytes.find(needle);
+  for (int i = 0; i < n && at != std::string::npos; ++i) at = bytes.find(needle, at + 1);
+  EXPECT_NE(at, std::string::npos) << needle << " #" << n;
+  return at;
+}
+
+}  // namespace
+
+// Archive-level corruption (hard-cases.md §6 item 35): a CRC that does not match the data, a central
+// directory that disagrees with a local header, two entries of the same name, and an entry count that
+// disagrees with the directory. Each is a located error, at the archive or at the entry.
+TEST(Gldf, CorruptedArchivesAreLocatedErrors) {
+  const fs::path p = lumx_test::unique_temp_path("gldf_corrupt.gldf");
+  const std::string ldt = fixture_ldt();
+  write_zip(p, {{"product.xml", kProduct}, {"ldc/a.ldt", ldt}}, /*store=*/true);
+  const std::string good = read_bytes(p);
+  ASSERT_NO_THROW((void)read_gldf(p.string()));
+  ASSERT_NO_THROW((void)read_gldf_entry(p.string(), "ldc/a.ldt"));
+
+  // One changed byte in the stored data of the LDT: the CRC-32 no longer matches.
+  std::string bad = good;
+  const std::size_t data = good.find(ldt.substr(0, 40));
+  ASSERT_NE(data, std::string::npos);
+  bad[data + 10] ^= 0x01;
+  write_bytes(p, bad);
+  try {
+    (void)read_gldf_entry(p.string(), "ldc/a.ldt");
+    ADD_FAILURE() << "a CRC mismatch was read";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.diagnostic().file, p.string() + "!/ldc/a.ldt") << e.what();
+    EXPECT_NE(std::string(e.what()).find("CRC"), std::string::npos) << e.what();
+  }
+
+  // The local header names another file than the central directory ("ldc/a.ldt" → "ldc/b.ldt" in the
+  // first occurrence, the local header): libzip's consistency check refuses the archive.
+  bad = good;
+  bad[nth(good, "ldc/a.ldt", 0) + 4] = 'b';
+  write_bytes(p, bad);
+  Diagnostic d = error_of(p);
+  EXPECT_EQ(d.file, p.string()) << d.str();
+  EXPECT_EQ(d.field, "ZIP") << d.str();
+
+  // The local header's compressed size disagrees with the central directory's (local header: PK\3\4, the
+  // compressed size at offset 18).
+  bad = good;
+  const std::size_t local = nth(good, std::string("PK\x03\x04", 4), 1);
+  bad[local + 18] = static_cast<char>(bad[local + 18] + 1);
+  write_bytes(p, bad);
+  d = error_of(p);
+  EXPECT_EQ(d.field, "ZIP") << d.str();
+
+  // Two entries named product.xml, in both their local headers and the directory: refused, since readers
+  // that take the first and readers that take the last would see different products.
+  write_zip(p, {{"product.xml", kProduct}, {"product.xmX", "<Root/>"}, {"ldc/a.ldt", ldt}}, true);
+  bad = read_bytes(p);
+  for (std::size_t at = bad.find("product.xmX"); at != std::string::npos; at = bad.find("product.xmX", at))
+    bad[at + 10] = 'l';
+  write_bytes(p, bad);
+  d = error_of(p);
+  EXPECT_EQ(d.file, p.string()) << d.str();
+  EXPECT_EQ(d.field, "ZIP") << d.str();
+  EXPECT_NE(d.message.find("same name"), std::string::npos) << d.str();
+
+  // The end-of-directory record's entry counts (offsets 8 and 10 after PK\5\6) one more, then one less,
+  // than the directory holds.
+  for (const int delta : {+1, -1}) {
+    bad = good;
+    const std::size_t end = nth(good, std::string("PK\x05\x06", 4), 0);
+    bad[end + 8] = static_cast<char>(bad[end + 8] + delta);
+    bad[end + 10] = static_cast<char>(bad[end + 10] + delta);
+    write_bytes(p, bad);
+    d = error_of(p);
+    EXPECT_EQ(d.file, p.string()) << delta << ": " << d.str();
+    EXPECT_EQ(d.field, "ZIP") << delta << ": " << d.str();
+  }
+  // The archive cut short anywhere in its directory or end record.
+  for (std::size_t cut = nth(good, std::string("PK\x01\x02", 4), 0); cut < good.size(); cut += 7) {
+    write_bytes(p, good.substr(0, cut));
+    EXPECT_EQ(error_of(p).field, "ZIP") << "cut at " << cut;
+  }
   fs::remove(p);
 }

@@ -3,6 +3,8 @@
 // ZIP reading with libzip; the archive checks that make extraction safe (zip_archive.h).
 #include "io/gldf/zip_archive.h"
 
+#include <set>
+
 #include <zip.h>
 
 #include <filesystem>
@@ -49,7 +51,9 @@ ZipArchive::ZipArchive(const std::string& path, const GldfLimits& limits) : path
     zip_error_init_with_code(&ze, err);
     const std::string msg = zip_error_strerror(&ze);
     zip_error_fini(&ze);
-    throw_at_field(path, "ZIP", "not a readable ZIP archive: " + msg);
+    // libzip refuses an archive whose directory names one entry twice with ZIP_ER_EXISTS.
+    throw_at_field(path, "ZIP", err == ZIP_ER_EXISTS ? "two entries have the same name (" + msg + ")"
+                                                     : "not a readable ZIP archive: " + msg);
   }
   zip_ = z;
   try {
@@ -58,6 +62,7 @@ ZipArchive::ZipArchive(const std::string& path, const GldfLimits& limits) : path
     if (static_cast<std::uint64_t>(n) > limits.max_entries)
       throw_at_field(path, "ZIP", std::to_string(n) + " entries exceed GldfLimits::max_entries (" + std::to_string(limits.max_entries) + ")");
     std::uint64_t total = 0;
+    std::set<std::string> seen;
     for (zip_uint64_t i = 0; i < static_cast<zip_uint64_t>(n); ++i) {
       zip_stat_t st;
       zip_stat_init(&st);
@@ -67,6 +72,10 @@ ZipArchive::ZipArchive(const std::string& path, const GldfLimits& limits) : path
       const std::string where = path + "!/" + name;
       if (const std::string why = unsafe_name(name); !why.empty())
         throw_at_field(where, "entry name", "refused: the name has " + why);
+      // Readers that take the first of two equal names and readers that take the last would see different
+      // products: an archive that is ambiguous is refused.
+      if (!seen.insert(name).second)
+        throw_at_field(where, "entry name", "refused: the archive holds two entries of this name (named twice)");
       if ((st.valid & ZIP_STAT_ENCRYPTION_METHOD) && st.encryption_method != ZIP_EM_NONE)
         throw_at_field(where, "entry", "refused: encrypted");
       if (!(st.valid & ZIP_STAT_SIZE)) throw_at_field(where, "entry size", "unknown");
