@@ -5,6 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=$(bash scripts/build.sh "$@" | tail -n 1)
+bash scripts/gltf_validator.sh  # the Khronos glTF-Validator for the glTF writer's test (npm, into out/tools/)
 skip=()
 if [ "${1:-}" = "--sanitize" ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

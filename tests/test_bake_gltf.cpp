@@ -651,6 +651,16 @@ TEST(GltfBadInput, MalformedJsonAndGlbContainersAreLocatedByByteOffset) {
   d = variant("bin_length.glb", [&](auto& b) { put32(b, bin_header, 0xFFFFFFF0u); });
   EXPECT_EQ(d.field, "GLB chunk length");
   EXPECT_EQ(d.byte_offset, std::int64_t(bin_header));
+  d = variant("json_unaligned.glb", [&](auto& b) { put32(b, 12, json_length - 1); });
+  EXPECT_EQ(d.field, "GLB chunk length");
+  EXPECT_EQ(d.byte_offset, 12);
+  EXPECT_NE(d.message.find("multiple of 4"), std::string::npos) << d.str();
+  d = variant("bin_unaligned.glb", [&](auto& b) {
+    const std::uint32_t bin_length = b[bin_header] | b[bin_header + 1] << 8 | b[bin_header + 2] << 16 | b[bin_header + 3] << 24;
+    put32(b, bin_header, bin_length - 2);
+  });
+  EXPECT_EQ(d.field, "GLB chunk length");
+  EXPECT_EQ(d.byte_offset, std::int64_t(bin_header));
   d = variant("bin_missing.glb", [&](auto& b) { b.resize(bin_header); put32(b, 8, std::uint32_t(bin_header)); });
   EXPECT_EQ(d.field, "/buffers/0");
   d = variant("json_bad.glb", [](auto& b) { b[20] = '['; });

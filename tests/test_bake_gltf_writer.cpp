@@ -14,7 +14,11 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+
+#include <sys/wait.h>
 
 namespace {
 
@@ -157,3 +161,58 @@ TEST(BakeGltfWriter, RaysetEmittersAreRefusedByName) {
 }
 
 }  // namespace
+
+namespace {
+
+/// The Khronos glTF-Validator's module folder: $LUMX_GLTF_VALIDATOR, else out/tools/node_modules/gltf-validator
+/// (installed there by scripts/gltf_validator.sh). Empty if neither exists.
+fs::path gltf_validator_module() {
+  if (const char* env = std::getenv("LUMX_GLTF_VALIDATOR"); env && *env) return env;
+  const fs::path p = fs::path(LUMX_SOURCE_DIR) / "out" / "tools" / "node_modules" / "gltf-validator";
+  return fs::exists(p / "package.json") ? p : fs::path();
+}
+
+/// Runs tests/tools/gltf_validate.mjs on `files`; its exit status and output.
+std::pair<int, std::string> run_validator(const fs::path& module, const std::vector<fs::path>& files, const fs::path& log) {
+  std::string cmd = "node " + (fs::path(LUMX_SOURCE_DIR) / "tests" / "tools" / "gltf_validate.mjs").string() + " '" +
+                    module.string() + "'";
+  for (const auto& f : files) cmd += " '" + f.string() + "'";
+  cmd += " > '" + log.string() + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_text(log)};
+}
+
+}  // namespace
+
+// What write_gltf_luminaire writes is valid glTF 2.0 for the Khronos glTF-Validator (hard-cases.md §6 item
+// 25): .glb, .gltf with a data URI, and Draco-compressed, with no error and no warning.
+TEST(BakeGltfWriter, OutputPassesTheKhronosValidator) {
+  const fs::path module = gltf_validator_module();
+  if (module.empty() || std::system("node --version > /dev/null 2>&1") != 0) {
+    if (in_ci()) FAIL() << "the glTF-Validator is missing (bash scripts/gltf_validator.sh installs it), but CI has it";
+    GTEST_SKIP() << "no Node.js or glTF-Validator (bash scripts/gltf_validator.sh installs it)";
+  }
+  const LuminaireScene scene = sample_scene();
+  const fs::path dir = unique_temp_path("lumx_gltf_validator");
+  fs::create_directories(dir);
+  std::vector<fs::path> files;
+  for (const int variant : {0, 1, 2}) {
+    lumx::bake::GltfWriteOptions o;
+    o.binary = variant != 1;
+    o.draco = variant == 2;
+    files.push_back(dir / (variant == 0 ? "lamp.glb" : variant == 1 ? "lamp.gltf" : "lamp_draco.glb"));
+    lumx::bake::write_gltf_luminaire(scene, files.back().string(), o);
+  }
+  const auto [status, report] = run_validator(module, files, dir / "report.txt");
+  EXPECT_EQ(status, 0) << report;
+  for (const auto& f : files) EXPECT_NE(report.find(f.string() + " errors 0 warnings 0 "), std::string::npos) << report;
+  // The check can fail: a GLB whose JSON chunk is one byte short is an error for the validator.
+  std::string bad = read_text(files[0]);
+  bad[12] = static_cast<char>(bad[12] - 1);
+  const fs::path broken = dir / "broken.glb";
+  std::ofstream(broken, std::ios::binary) << bad;
+  const auto [bad_status, bad_report] = run_validator(module, {broken}, dir / "bad_report.txt");
+  EXPECT_EQ(bad_status, 1) << bad_report;
+  EXPECT_EQ(bad_report.find(broken.string() + " errors 0 "), std::string::npos) << bad_report;
+  fs::remove_all(dir);
+}

@@ -291,6 +291,11 @@ Document::Document(const std::string& path, const GltfReadOptions& options)
         throw_at_offset(path, std::int64_t(off), "GLB chunk length",
                         "chunk of " + std::to_string(chunk_length) + " bytes runs past the end of the file (" +
                             std::to_string(length - off - 8) + " bytes left)");
+      // glTF 2.0, GLB format, chunks: every chunk starts and ends on a 4-byte boundary (padded with spaces or
+      // zeros), so a length that is not a multiple of 4 is a broken or hand-made container.
+      if (chunk_length % 4 != 0)
+        throw_at_offset(path, std::int64_t(off), "GLB chunk length",
+                        "is " + std::to_string(chunk_length) + ", not a multiple of 4 (chunks are 4-byte aligned)");
       if (!have_json) {
         if (chunk_type != kChunkJson)
           throw_at_offset(path, std::int64_t(off + 4), "GLB chunk type", "the first chunk must be JSON");
