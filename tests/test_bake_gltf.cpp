@@ -916,3 +916,54 @@ TEST(LuminaireCheck, EmissiveSidesAndClosedness) {
   EXPECT_NE(find(open, lumx::Severity::note, "/meshes/0/primitives/0", "single-sided"), nullptr);
   for (const auto& d : open) EXPECT_NE(d.severity, lumx::Severity::error) << d.str();
 }
+
+// Files a .gltf names (hard-cases.md §6 item 23): only the glTF file's folder and below. '../', an absolute
+// path, a symbolic link out of the folder and file:// are located errors even when the file exists; shell
+// syntax in a name is a file name, never run; a trusted caller may allow the folder's outside.
+TEST(GltfBadInput, FilesOutsideTheGltfFolderAreRefused) {
+  const auto root = lumx_gltf_test::scratch_dir("uri_policy");
+  const fs::path dir = root / "lamp";
+  fs::create_directories(dir / "sub");
+  GltfBuilder b = emissive_quad();
+  // The buffer exists outside the folder, inside it and in a sub-folder.
+  b.write_gltf_external(root / "outside.gltf", "outside.bin");
+  b.write_gltf_external(dir / "inside.gltf", "inside.bin");
+  b.write_gltf_external(dir / "sub" / "deeper.gltf", "deeper.bin");
+  fs::create_symlink(root / "outside.bin", dir / "link.bin");
+  auto with_uri = [&](const std::string& name, const std::string& uri) {
+    lumx_gltf_test::write_text(dir / name, b.with_buffer(uri).dump());
+    return dir / name;
+  };
+  EXPECT_NO_THROW(bake::read_gltf_luminaire(with_uri("ok.gltf", "inside.bin").string()));
+  EXPECT_NO_THROW(bake::read_gltf_luminaire(with_uri("ok_sub.gltf", "sub/deeper.bin").string()));
+  EXPECT_NO_THROW(bake::read_gltf_luminaire(with_uri("ok_dots.gltf", "sub/../inside.bin").string()));
+  EXPECT_NO_THROW(bake::read_gltf_luminaire(with_uri("ok_escaped.gltf", "sub%2Fdeeper.bin").string()));
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"parent.gltf", "../outside.bin"},
+      {"parent_escaped.gltf", "%2E%2E/outside.bin"},
+      {"deep_parent.gltf", "sub/../../outside.bin"},
+      {"absolute.gltf", (root / "outside.bin").string()},
+      {"link.gltf", "link.bin"},
+      {"file_scheme.gltf", "file://" + (dir / "inside.bin").string()},
+  };
+  for (const auto& [name, uri] : refused) {
+    const lumx::Diagnostic d = read_error(with_uri(name, uri));
+    EXPECT_EQ(d.field, "/buffers/0/uri") << uri << ": " << d.str();
+    EXPECT_EQ(d.file, (dir / name).string()) << d.str();
+  }
+  EXPECT_NE(read_error(with_uri("why.gltf", "../outside.bin")).message.find("allow_files_outside_folder"), std::string::npos);
+  // Shell syntax is part of a file name: the file does not exist, and nothing runs.
+  for (const std::string uri : {"$(touch ran_dollar).bin", "`touch ran_backtick`.bin", "x.bin; touch ran_semicolon"}) {
+    EXPECT_EQ(read_error(with_uri("shell.gltf", uri)).field, "/buffers/0/uri") << uri;
+  }
+  for (const char* marker : {"ran_dollar", "ran_backtick", "ran_semicolon"}) {
+    EXPECT_FALSE(fs::exists(dir / marker)) << marker;
+    EXPECT_FALSE(fs::exists(fs::current_path() / marker)) << marker;
+  }
+  // IES profiles (EXT_lights_ies) and ray files (LUMX_lights_rayset) are resolved by the same code
+  // (Document::resolve_uri). A trusted caller may follow paths out of the folder.
+  bake::GltfReadOptions trusted;
+  trusted.allow_files_outside_folder = true;
+  EXPECT_NO_THROW(bake::read_gltf_luminaire(with_uri("parent.gltf", "../outside.bin").string(), trusted));
+  EXPECT_NO_THROW(bake::read_gltf_luminaire(with_uri("absolute.gltf", (root / "outside.bin").string()).string(), trusted));
+}

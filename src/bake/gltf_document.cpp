@@ -370,8 +370,22 @@ std::filesystem::path Document::resolve_uri(const std::string& uri, const std::s
     }
   }
   if (decoded.empty()) fail(pointer, "is empty");
-  const std::filesystem::path p(decoded);
-  return p.is_absolute() ? p : base_dir_ / p;
+  namespace fs = std::filesystem;
+  const fs::path p(decoded);
+  if (options_.allow_files_outside_folder) return p.is_absolute() ? p : base_dir_ / p;
+  // A file from a download names files beside it; an absolute path, '..' or a symbolic link out of the
+  // glTF file's folder is refused, so that a luminaire cannot make an application read what it holds.
+  // The name is never given to a shell: '$(...)' or backticks are only characters of a file name.
+  const char* option = " (GltfReadOptions::allow_files_outside_folder)";
+  if (p.is_absolute()) fail(pointer, "'" + uri + "' is an absolute path; only files in the glTF file's folder are read" + option);
+  const fs::path folder = base_dir_.empty() ? fs::path(".") : base_dir_;
+  std::error_code ec_folder, ec_file;
+  const fs::path real_folder = fs::weakly_canonical(folder, ec_folder);
+  const fs::path real_file = fs::weakly_canonical(folder / p, ec_file);
+  const fs::path inside = real_file.lexically_relative(real_folder);
+  if (ec_folder || ec_file || inside.empty() || *inside.begin() == "..")
+    fail(pointer, "'" + uri + "' leads out of the glTF file's folder" + option);
+  return folder / p;
 }
 
 std::vector<std::uint8_t> Document::uri_bytes(const std::string& uri, const std::string& pointer,

@@ -68,6 +68,9 @@ struct GltfReadOptions {
   std::uint64_t max_vertices = 100'000'000;  ///< over the whole scene, after instancing by nodes
   std::uint64_t max_nodes_placed = 1'000'000;  ///< node visits while walking the scene
   std::uint64_t max_parts = 1'000'000;         ///< primitives placed by nodes, over the whole scene
+  /// Files a .gltf names (buffers, IES profiles, ray files) must lie in its folder or below: an absolute
+  /// path, '..' or a symbolic link out of the folder is an error. True also follows those (trusted input).
+  bool allow_files_outside_folder = false;
 };
 
 /// Reads a luminaire. Throws lumx::Error with a located diagnostic (file, byte offset or JSON pointer).
