@@ -4,6 +4,7 @@
 // views, accessors and Draco primitives, validated before they are read.
 #include "bake/gltf_document.h"
 #include "io/json_depth.h"
+#include "io/json_members.h"
 
 #include <draco/compression/decode.h>
 #include <draco/core/decoder_buffer.h>
@@ -315,8 +316,9 @@ Document::Document(const std::string& path, const GltfReadOptions& options)
       at != std::string_view::npos)
     throw_at_offset(path, json_offset + std::int64_t(at), "JSON",
                     "nested more than " + std::to_string(lumx::detail::kMaxJsonDepth) + " levels deep");
+  lumx::detail::RepeatedMemberWatch<Json> members;
   try {
-    json_ = Json::parse(json_begin, json_begin + json_size);
+    json_ = Json::parse(json_begin, json_begin + json_size, members.callback());
   } catch (const Json::parse_error& e) {
     std::string msg = e.what();
     const auto colon = msg.find("] ");
@@ -333,7 +335,13 @@ Document::Document(const std::string& path, const GltfReadOptions& options)
     }
     msg = printable;
     throw_at_offset(path, json_offset + std::int64_t(e.byte > 0 ? e.byte - 1 : 0), "JSON", msg);
+  } catch (const Json::exception& e) {  // a number beyond double's range (out_of_range 406) has no position
+    const std::string_view text(reinterpret_cast<const char*>(json_begin), json_size);
+    const std::size_t at = lumx::detail::json_overflow_at(text, e.what());
+    throw_at_offset(path, at == std::string_view::npos ? -1 : json_offset + std::int64_t(at), "JSON",
+                    "a number beyond the range of a double");
   }
+  if (!members.repeated().empty()) fail(members.repeated(), "this name appears twice in its object; readers disagree on which value counts");
   if (!json_.is_object()) throw_at_field(path, "", "the glTF JSON must be an object");
   buffers_.resize(count("buffers"));
 }

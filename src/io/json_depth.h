@@ -37,5 +37,33 @@ inline std::size_t json_too_deep_at(std::string_view text, std::size_t max_depth
   return std::string_view::npos;
 }
 
+/// Byte offset of the first number token equal to `token` outside strings, or npos. nlohmann/json reports a
+/// number beyond double's range (out_of_range 406) without its position; this finds it again.
+inline std::size_t json_number_at(std::string_view text, std::string_view token) {
+  auto part_of_number = [](char c) { return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.' || c == 'e' || c == 'E'; };
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (text.compare(i, token.size(), token) == 0 && (i == 0 || !part_of_number(text[i - 1])) &&
+               (i + token.size() == text.size() || !part_of_number(text[i + token.size()]))) {
+      return i;
+    }
+  }
+  return std::string_view::npos;
+}
+
+/// The position-free exception's number, quoted in its message ("... parsing '1e400'"), found in `text`.
+inline std::size_t json_overflow_at(std::string_view text, const std::string& message) {
+  const std::size_t open = message.find('\'');
+  const std::size_t close = open == std::string::npos ? open : message.find('\'', open + 1);
+  if (close == std::string::npos) return std::string_view::npos;
+  return json_number_at(text, std::string_view(message).substr(open + 1, close - open - 1));
+}
+
 }  // namespace detail
 LUMX_NAMESPACE_END

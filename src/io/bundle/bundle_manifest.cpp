@@ -3,6 +3,7 @@
 // src/io/bundle/bundle_manifest.cpp — manifest serialisation and validating parser.
 #include "io/bundle/bundle_manifest.h"
 #include "io/json_depth.h"
+#include "io/json_members.h"
 
 #include <lumx/math/sphere_map.h>
 
@@ -211,8 +212,9 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     d.message = "nested more than " + std::to_string(detail::kMaxJsonDepth) + " levels deep";
     throw Error(std::move(d));
   }
+  detail::RepeatedMemberWatch<json> members;
   try {
-    j = json::parse(text.begin(), text.end());
+    j = json::parse(text.begin(), text.end(), members.callback());
   } catch (const json::parse_error& e) {
     Diagnostic d;
     d.file = file;
@@ -220,9 +222,18 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     d.field = "JSON";
     d.message = e.what();
     throw Error(std::move(d));
-  } catch (const json::exception& e) {  // e.g. a number beyond double's range (out_of_range 406)
-    r.fail("", std::string("not valid JSON for a manifest: ") + e.what());
+  } catch (const json::exception& e) {  // a number beyond double's range (out_of_range 406): no position given
+    const std::size_t at = detail::json_overflow_at(text, e.what());
+    if (at == std::string_view::npos) r.fail("", std::string("not valid JSON for a manifest: ") + e.what());
+    Diagnostic d;
+    d.file = file;
+    d.byte_offset = std::int64_t(at);
+    d.field = "JSON";
+    d.message = "a number beyond the range of a double";
+    throw Error(std::move(d));
   }
+  if (!members.repeated().empty())
+    r.fail(members.repeated(), "this name appears twice in its object; readers disagree on which value counts");
   if (!j.is_object()) r.fail("", "the manifest is not a JSON object");
   r.only(j, "", {"format", "format_version", "generator", "units", "channels", "bounding_sphere", "provenance",
                  "levels", "volume", "attachments"});

@@ -3,6 +3,7 @@
 // The TM-33 element tree: XML via libxml2, the JSON form via nlohmann-json, both located (tm33_tree.h).
 #include "io/photometry/tm33_tree.h"
 #include "io/json_depth.h"
+#include "io/json_members.h"
 
 #include "io/text_scanner.h"
 
@@ -279,8 +280,9 @@ Tm33Node parse_tm33_json_tree(std::string_view text, const std::string& file) {
   if (const std::size_t at = detail::json_too_deep_at(text); at != std::string_view::npos)
     throw_at_line(file, 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n')), "JSON",
                   "nested more than " + std::to_string(detail::kMaxJsonDepth) + " levels deep");
+  detail::RepeatedMemberWatch<ojson> members;
   try {
-    j = ojson::parse(text.begin(), text.end());
+    j = ojson::parse(text.begin(), text.end(), members.callback());
   } catch (const ojson::parse_error& e) {
     const std::size_t at = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
     const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
@@ -288,9 +290,13 @@ Tm33Node parse_tm33_json_tree(std::string_view text, const std::string& file) {
     const std::size_t colon = msg.find("parse error");
     if (colon != std::string::npos) msg = msg.substr(colon);
     throw_at_line(file, line, "JSON", msg);
-  } catch (const ojson::exception& e) {  // e.g. a number too large for a double: no position is known
-    throw_at_field(file, "JSON", e.what());
+  } catch (const ojson::exception& e) {  // a number too large for a double: nlohmann gives no position
+    const std::size_t at = detail::json_overflow_at(text, e.what());
+    if (at == std::string_view::npos) throw_at_field(file, "JSON", e.what());
+    throw_at_line(file, 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n')), "JSON",
+                  "a number beyond the range of a double");
   }
+  if (!members.repeated().empty()) throw_at_field(file, members.repeated(), "this name appears twice in its object; readers disagree on which value counts");
   if (!j.is_object() || j.size() != 1)
     throw_at_field(file, "/", "a TM-33 JSON document is an object with one member, the root element");
   const auto it = j.begin();
