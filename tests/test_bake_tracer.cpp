@@ -15,6 +15,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <thread>
+
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cstdio>
@@ -145,6 +148,71 @@ TEST(BakeTracer, IntegratingSphereExitFlux) {
                                     t.counters.depth_capped + t.counters.leaked);
   EXPECT_GT(t.counters.roulette_killed, 0u);
   EXPECT_NEAR(t.counters.exited_lm, exit.sum, 1e-6 * exit.sum);
+}
+
+// Russian roulette must not change the mean (hard-cases.md §6 item 42): the same integrating sphere traced
+// with roulette from the first bounce on and without it (up to the depth cap 256, where a particle keeps 0.8^256 ≈ 1e-25
+// of its flux) gives exit fluxes that agree within 5 standard errors of their difference, with independent
+// seeds. Roulette trades bounces for variance: it must end paths earlier.
+TEST(BakeTracer, RouletteKeepsTheMeanAndShortensPaths) {
+  SceneBuilder b("integrating sphere");
+  b.begin_part("wall", b.add_material(lambertian(0.8)));
+  add_sphere(b, 0.1, 32, 64, std::acos(0.9), /*outward=*/false);
+  b.point_light({0, 0, 0}, 10.0);
+  const Tracer tracer(b.scene());
+  const std::uint64_t n = 100000;
+  auto trace = [&](int roulette_depth, std::uint64_t seed, double& mean, double& se, double& bounces) {
+    TraceOptions o;
+    o.particles = n;
+    o.seed = seed;
+    o.roulette_depth = roulette_depth;
+    o.max_depth = 256;
+    CollectingSink sink;
+    const TraceCounters c = tracer.trace(o, sink);
+    Estimate e;
+    double b_sum = 0;
+    for (const ExitParticle& x : sink.exits) {
+      e.add(luminance(glm::dvec3(x.flux_lm)));
+      b_sum += x.bounces;
+    }
+    mean = e.sum;
+    se = e.standard_error(n);
+    bounces = b_sum / double(std::max<std::size_t>(1, sink.exits.size()));
+    // Without roulette a path stays inside for 256 bounces with probability 0.95^256 ≈ 2e-6 (a few of 10⁵),
+    // carrying 0.8^256 of its flux: the cap loses nothing measurable.
+    EXPECT_LE(c.depth_capped, 5u) << roulette_depth;
+    return c;
+  };
+  double with_mean, with_se, with_bounces, without_mean, without_se, without_bounces;
+  const TraceCounters with = trace(1, 11, with_mean, with_se, with_bounces);
+  const TraceCounters without = trace(1 << 30, 12, without_mean, without_se, without_bounces);
+  const double sigma = std::hypot(with_se, without_se);
+  std::printf("roulette from bounce 1: %.4f ± %.4f lm (%llu killed, mean exit bounces %.2f); none: %.4f ± %.4f lm "
+              "(mean exit bounces %.2f); difference %.2f σ\n",
+              with_mean, with_se, static_cast<unsigned long long>(with.roulette_killed), with_bounces, without_mean,
+              without_se, without_bounces, (with_mean - without_mean) / sigma);
+  EXPECT_LT(std::abs(with_mean - without_mean), 5 * sigma);
+  EXPECT_GT(with.roulette_killed, n / 10);
+  EXPECT_EQ(without.roulette_killed, 0u);
+  EXPECT_LT(with_bounces, without_bounces);
+  // Zero throughput never divides by zero: a black wall (albedo 0) absorbs every particle at its first hit,
+  // with roulette from bounce 0, and leaves no NaN anywhere.
+  SceneBuilder black("black sphere");
+  black.begin_part("wall", black.add_material(lambertian(0.0)));
+  add_sphere(black, 0.1, 16, 32, std::acos(0.9), false);
+  black.point_light({0, 0, 0}, 10.0);
+  const Tracer black_tracer(black.scene());
+  TraceOptions o;
+  o.particles = 10000;
+  o.roulette_depth = 0;
+  CollectingSink sink;
+  const TraceCounters c = black_tracer.trace(o, sink);
+  for (const ExitParticle& x : sink.exits) {
+    ASSERT_TRUE(std::isfinite(x.flux_lm.x) && std::isfinite(x.flux_lm.y) && std::isfinite(x.flux_lm.z));
+    EXPECT_EQ(x.bounces, 0u);  // only the particles that leave through the port at once
+  }
+  EXPECT_TRUE(std::isfinite(c.exited_lm));
+  EXPECT_EQ(c.emitted, c.exited + c.absorbed + c.roulette_killed + c.depth_capped + c.leaked);
 }
 
 // A point light at the centre of a smooth glass ball (η = 1.5) with Beer–Lambert absorption σ: every path
@@ -362,8 +430,15 @@ TEST(BakeTracer, BitIdenticalForAnyThreadCountChunkAndPass) {
            a.bounces == c.bounces;
   };
   for (std::size_t i = 0; i < one.sink.exits.size(); ++i) ASSERT_TRUE(same(one.sink.exits[i], two.sink.exits[i])) << i;
+  // 7 threads (more than the cores) and as many as the machine has (hard-cases.md §6 item 48).
+  for (const int threads : {7, int(std::max(1u, std::thread::hardware_concurrency()))}) {
+    const Trace many = run(tracer, n, threads, 777);
+    ASSERT_EQ(many.sink.exits.size(), one.sink.exits.size()) << threads;
+    for (std::size_t i = 0; i < one.sink.exits.size(); ++i) ASSERT_TRUE(same(one.sink.exits[i], many.sink.exits[i])) << threads << ": " << i;
+  }
   // Counters are reduced in chunk order, not thread order: bit-identical for the same chunk size.
   EXPECT_EQ(one.counters.exited_lm, run(tracer, n, 2, 4096).counters.exited_lm);
+  EXPECT_EQ(one.counters.exited_lm, run(tracer, n, 7, 4096).counters.exited_lm);
   EXPECT_NE(run(tracer, n, 2, 4096, 8).sink.exits.front().direction, one.sink.exits.front().direction);
 
   CollectingSink passes;

@@ -17,6 +17,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 
 using namespace lumx;
@@ -173,6 +175,13 @@ TEST(IlluminanceGrid, InverseSquareCosineOfAPointSource) {
   EXPECT_NEAR(g.x_min_m, -g.x_max_m, 1e-9);  // symmetric source, symmetric box
   o.tilt_deg = 100;
   EXPECT_THROW(illuminance_grid(t, o), std::invalid_argument);
+  // A point source at distance 0 has no finite illuminance (hard-cases.md §6 item 45): mounting heights of
+  // 0, below 0 and NaN are refused, never a grid of Inf or NaN.
+  for (const double bad : {0.0, -1.0, std::nan("")}) {
+    IlluminanceGridOptions z;
+    z.mounting_height_m = bad;
+    EXPECT_THROW(illuminance_grid(t, z), std::invalid_argument) << bad;
+  }
 }
 
 TEST(IlluminanceGrid, TiltMovesTheSpotTowardsPlusY) {
@@ -211,6 +220,8 @@ TEST(ConeDiagram, CosPowerBeamInClosedForm) {
     EXPECT_NEAR(r.mean_beam_lux, flux / area, 1e-2 * flux / area);
   }
   EXPECT_THROW(cone_diagram(IntensityTable(isotropic()), {1}), std::invalid_argument);  // no beam
+  for (const double bad : {0.0, -2.0, std::nan(""), std::numeric_limits<double>::infinity()})
+    EXPECT_THROW(cone_diagram(IntensityTable(p), {1, bad}), std::invalid_argument) << bad;  // d ≤ 0 (item 45)
 }
 
 TEST(PhotometricMetrics, DarkLuminaireGivesZerosNotNaN) {

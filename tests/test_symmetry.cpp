@@ -8,6 +8,8 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include <limits>
+
 using namespace lumx;
 
 namespace {
@@ -129,4 +131,67 @@ TEST(Frames, AnglesRoundTripForAllTypes) {
   const PhotometricAngles b = angles_from_direction(PhotometricType::B, direction_from_angles(PhotometricType::C, 30, 40));
   EXPECT_NEAR(std::tan(b.horizontal_deg * kDegToRad), std::cos(c) * std::tan(g), 1e-12);
   EXPECT_NEAR(std::sin(b.vertical_deg * kDegToRad), std::sin(c) * std::sin(g), 1e-12);
+}
+
+// Poles, grazing angles and directions whose length is 1 ± ulp (hard-cases.md §6 item 46): no NaN, and the
+// angles within 1e-6 rad of the exact ones, since the inverse uses atan2 of both components, never acos of
+// a dot product (whose argument 1 + ulp would be NaN and whose slope is infinite at ±1).
+TEST(Frames, PolesGrazingAndNearUnitDirectionsGiveExactAnglesWithoutNaN) {
+  const double ulp = std::numeric_limits<double>::epsilon();
+  const double tol_deg = 1e-6 * kRadToDeg;
+  for (PhotometricType t : {PhotometricType::A, PhotometricType::B, PhotometricType::C}) {
+    // The photometric zero (nadir) and its opposite, lengthened and shortened by an ulp.
+    for (const double s : {1.0 - ulp, 1.0, 1.0 + ulp, 1.0 + 4 * ulp}) {
+      const PhotometricAngles nadir = angles_from_direction(t, s * direction_from_angles(t, 0, 0));
+      EXPECT_TRUE(std::isfinite(nadir.vertical_deg) && std::isfinite(nadir.horizontal_deg));
+      EXPECT_NEAR(nadir.vertical_deg, 0.0, tol_deg);
+      EXPECT_NEAR(nadir.horizontal_deg, 0.0, tol_deg);
+    }
+  }
+  // Type C: the poles γ = 0 and 180 (C is 0 there), grazing 1e-7 rad from each pole and from the horizon.
+  const double e = 1e-7;
+  struct Case {
+    glm::dvec3 d;
+    double gamma_rad;
+  };
+  const Case cases[] = {{{0, 0, -1}, 0},
+                        {{0, 0, 1}, M_PI},
+                        {{0, 0, -(1 + ulp)}, 0},
+                        {{0, 0, 1 + ulp}, M_PI},
+                        {{e, 0, -1}, std::atan(e)},
+                        {{e, 0, 1}, M_PI - std::atan(e)},
+                        {{1, 0, -e}, M_PI / 2 - std::atan(e)},
+                        {{1, 0, e}, M_PI / 2 + std::atan(e)},
+                        {{1e-300, 0, -1}, 1e-300},
+                        {{1, 0, 0}, M_PI / 2},
+                        {{-1, 1e-300, 0}, M_PI / 2}};
+  for (const Case& c : cases) {
+    const PhotometricAngles a = angles_from_direction(PhotometricType::C, c.d);
+    ASSERT_TRUE(std::isfinite(a.vertical_deg) && std::isfinite(a.horizontal_deg)) << c.d.x << ' ' << c.d.z;
+    EXPECT_NEAR(a.vertical_deg * kDegToRad, c.gamma_rad, 1e-6) << c.d.x << ' ' << c.d.z;
+    EXPECT_GE(a.horizontal_deg, 0.0);
+    EXPECT_LT(a.horizontal_deg, 360.0);
+  }
+  // Antiparallel directions: γ of −d is 180° − γ of d, with C turned by 180° (all types round trip).
+  for (const double g : {0.0, 1e-7, 30.0, 90.0, 179.9999999, 180.0}) {
+    const glm::dvec3 d = direction_from_angles(PhotometricType::C, 40, g);
+    const PhotometricAngles back = angles_from_direction(PhotometricType::C, -d);
+    EXPECT_NEAR(back.vertical_deg, 180.0 - g, tol_deg) << g;
+    if (g > 1e-6 && g < 180 - 1e-6) {
+      EXPECT_NEAR(back.horizontal_deg, 220.0, 1e-6) << g;
+    }
+  }
+  // Round trips that reach the poles and the horizon (the test above stops 1° short).
+  for (const double v : {0.0, 1e-7, 89.9999999, 90.0, 90.0000001, 179.9999999, 180.0}) {
+    const PhotometricAngles a = angles_from_direction(PhotometricType::C, direction_from_angles(PhotometricType::C, 123, v));
+    EXPECT_NEAR(a.vertical_deg, v, 1e-9) << v;
+    if (v > 1e-6 && v < 180 - 1e-6) {
+      EXPECT_NEAR(a.horizontal_deg, 123, 1e-6) << v;
+    }
+  }
+  for (PhotometricType t : {PhotometricType::A, PhotometricType::B})
+    for (const double v : {-90.0, -89.9999999, 0.0, 89.9999999, 90.0}) {
+      const PhotometricAngles a = angles_from_direction(t, direction_from_angles(t, 45, v));
+      EXPECT_NEAR(a.vertical_deg, v, 1e-9) << v;
+    }
 }
