@@ -9,6 +9,7 @@
 #include <lumx/volume/radiance_volume.h>
 
 #include <gtest/gtest.h>
+#include <Imath/half.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -161,10 +162,10 @@ TEST(Bundle, FloatIsUsedWhereHalfWouldOverflowOrLosePrecision) {
     for (std::size_t i = 0; i < bright.levels[k].size(); ++i)
       EXPECT_EQ(bright.levels[k].apls[i].map.values(), back.levels[k].apls[i].map.values());  // exact
   // Forcing half refuses instead of writing Inf, and leaves nothing behind.
-  BundleWriteOptions half;
-  half.pixel_type = MapPixelType::half;
+  BundleWriteOptions forced_half;
+  forced_half.pixel_type = MapPixelType::half;
   const fs::path dir2 = scratch("forced") / "f.lumx";
-  EXPECT_THROW(write_bundle(dir2.string(), bright, nullptr, half), Error);
+  EXPECT_THROW(write_bundle(dir2.string(), bright, nullptr, forced_half), Error);
   EXPECT_FALSE(fs::exists(dir2));
   EXPECT_TRUE(fs::is_empty(dir2.parent_path()));
   // A dim radiometric set (peak 1e-3 W/sr) would sit in half's subnormal range: float.
@@ -172,6 +173,72 @@ TEST(Bundle, FloatIsUsedWhereHalfWouldOverflowOrLosePrecision) {
   const fs::path dir3 = scratch("dim") / "d.lumx";
   write_bundle(dir3.string(), dim);
   EXPECT_EQ(BundleReader(dir3.string()).manifest().levels[2].maps[0].pixel_type, "float");
+}
+
+namespace {
+
+/// One APL whose 2R × R map holds `value` everywhere except texel (0, 0), which holds `first`.
+AplSet one_map_set(float value, float first, int R = 8) {
+  AplSet set;
+  AplLevel level;
+  level.map_resolution = R;
+  Apl a;
+  a.map = SphereMap(R, 1);
+  for (float& v : a.map.values()) v = value;
+  a.map.at(0, 0, 0) = first;
+  level.apls.push_back(std::move(a));
+  set.levels.push_back(std::move(level));
+  update_fluxes(set);
+  set.bounds = bounding_sphere_of(set);
+  return set;
+}
+
+}  // namespace
+
+// Half's edges (hard-cases.md §6 item 26). OpenEXR's half (Imath) rounds to nearest, ties to even: 65504 is
+// its largest value, 65519 rounds down to it, 65520 overflows to +Inf; 2⁻²⁴ is its smallest subnormal and
+// 2⁻²⁵ (a tie) rounds to 0; 2049 (a tie between 2048 and 2050) rounds to 2048. The bundle writer stores
+// every map exactly or as half only where rounding keeps the value in range and the flux within 1e-4.
+TEST(Bundle, HalfConversionsAtTheEdgesOfItsRange) {
+  EXPECT_EQ(float(Imath::half(65504.0f)), 65504.0f);
+  EXPECT_EQ(float(Imath::half(65519.0f)), 65504.0f);
+  EXPECT_TRUE(std::isinf(float(Imath::half(65520.0f))));
+  EXPECT_EQ(float(Imath::half(0x1.0p-24f)), 0x1.0p-24f);
+  EXPECT_EQ(float(Imath::half(0x1.0p-25f)), 0.0f);
+  EXPECT_EQ(float(Imath::half(2049.0f)), 2048.0f);
+  EXPECT_EQ(float(Imath::half(2051.0f)), 2052.0f);
+
+  struct Case {
+    float value, first;
+    const char* pixel_type;  // what automatic chooses
+  };
+  const Case cases[] = {
+      {1.0f, 65504.0f, "half"},    // every value exact in half
+      {1.0f, 65519.0f, "float"},   // above half's largest value: half would change it
+      {1.0f, 65520.0f, "float"},   // half would overflow
+      {2049.0f, 2049.0f, "float"}, // every texel would lose 1 in 2049: the flux by 4.9e-4
+      {2048.0f, 2050.0f, "half"},  // exact in half
+  };
+  int n = 0;
+  for (const Case& c : cases) {
+    const AplSet set = one_map_set(c.value, c.first);
+    const fs::path dir = scratch("half_edges") / ("c" + std::to_string(n++) + ".lumx");
+    write_bundle(dir.string(), set);
+    BundleReader r(dir.string());
+    EXPECT_EQ(r.manifest().levels[0].maps[0].pixel_type, c.pixel_type) << c.first;
+    const AplSet back = r.load();
+    EXPECT_EQ(back.levels[0].apls[0].map.values(), set.levels[0].apls[0].map.values()) << c.first;  // exact
+    // Forced half: refused above 65504, even where rounding would give 65504, rather than store another value.
+    BundleWriteOptions forced_half;
+    forced_half.pixel_type = MapPixelType::half;
+    const fs::path forced = dir.parent_path() / ("forced" + std::to_string(n) + ".lumx");
+    if (c.first > 65504.0f) {
+      EXPECT_THROW(write_bundle(forced.string(), set, nullptr, forced_half), Error) << c.first;
+    } else {
+      write_bundle(forced.string(), set, nullptr, forced_half);
+      EXPECT_EQ(BundleReader(forced.string()).manifest().levels[0].maps[0].pixel_type, "half");
+    }
+  }
 }
 
 TEST(Bundle, PartialLoadingReadsOnlyWhatItNeeds) {
