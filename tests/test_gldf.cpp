@@ -287,6 +287,45 @@ TEST(Gldf, CorruptedArchivesAreLocatedErrors) {
     EXPECT_EQ(d.file, p.string()) << delta << ": " << d.str();
     EXPECT_EQ(d.field, "ZIP") << delta << ": " << d.str();
   }
+  // Entry names with a control character are refused by name (hard-cases.md §6 item 33); libzip will not
+  // write one, so the byte is patched into both headers of "ldc/aQ.ldt". (Other bytes below 0x20, such as
+  // ESC, make libzip read a name without the UTF-8 flag as CP437, which maps them to printable characters.)
+  for (const char control : {'\n', '\r', '\t', '\x7f'}) {
+    write_zip(p, {{"product.xml", kProduct}, {"ldc/aQ.ldt", ldt}}, true);
+    bad = read_bytes(p);
+    for (std::size_t at = bad.find("ldc/aQ.ldt"); at != std::string::npos; at = bad.find("ldc/aQ.ldt", at)) bad[at + 5] = control;
+    write_bytes(p, bad);
+    d = error_of(p);
+    EXPECT_EQ(d.field, "entry name") << int(control) << ": " << d.str();
+  }
+  // The data of an entry longer or shorter than both its headers state (the sizes changed in the local
+  // header and the directory alike, the CRC left): an error at the entry when it is read, never a buffer
+  // sized by the header and filled past its end (item 34).
+  for (const int delta : {-1, +1}) {
+    bad = good;
+    const std::size_t local_ldt = nth(good, std::string("PK\x03\x04", 4), 1);
+    const std::size_t central_ldt = nth(good, std::string("PK\x01\x02", 4), 1);
+    for (const std::size_t size_field : {local_ldt + 22, central_ldt + 24}) {  // uncompressed size
+      bad[size_field] = static_cast<char>(bad[size_field] + delta);
+    }
+    write_bytes(p, bad);
+    try {
+      (void)read_gldf_entry(p.string(), "ldc/a.ldt");
+      ADD_FAILURE() << "an entry of the wrong size was read (" << delta << ")";
+    } catch (const Error& e) {
+      EXPECT_NE(e.diagnostic().file.find(p.string()), std::string::npos) << e.what();
+    }
+  }
+  // Overlapping entries: the directory points the second entry at the first one's local header (the
+  // classic overlapping zip bomb); the names then disagree and the archive is refused (item 34).
+  bad = good;
+  {
+    const std::size_t central_ldt = nth(good, std::string("PK\x01\x02", 4), 1);
+    for (int k = 0; k < 4; ++k) bad[central_ldt + 42 + k] = 0;  // relative offset of the local header → 0
+  }
+  write_bytes(p, bad);
+  d = error_of(p);
+  EXPECT_EQ(d.field, "ZIP") << d.str();
   // The archive cut short anywhere in its directory or end record.
   for (std::size_t cut = nth(good, std::string("PK\x01\x02", 4), 0); cut < good.size(); cut += 7) {
     write_bytes(p, good.substr(0, cut));

@@ -6,6 +6,12 @@
 // text, and a streaming atomic file writer.
 #pragma once
 
+// The Neumaier sums below (and the exact comparisons of the readers) need IEEE arithmetic: -ffast-math lets
+// the compiler reassociate (a + b) − a to b, which removes the compensation (hard-cases.md §6 item 39).
+#if defined(__FAST_MATH__)
+#error "lumx's compensated flux sums need IEEE arithmetic: build lumx without -ffast-math"
+#endif
+
 #include <lumx/core/diagnostic.h>
 #include <lumx/io/rayset_io.h>
 #include <lumx/rays/rayset.h>
