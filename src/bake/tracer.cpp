@@ -57,7 +57,8 @@ struct Tracer::Impl {
   EmitterSampler emitters;
   double offset_scale = 1e-6;              // self-intersection offset, m (from the scene's extent)
 
-  std::vector<float> vertices;              // Embree's shared vertex buffer
+  glm::dvec3 frame_origin{0.0};             // Embree works relative to the luminaire's box centre (below)
+  std::vector<float> vertices;              // Embree's shared vertex buffer, relative to frame_origin
   std::vector<glm::vec3> triangle_normals;  // 3 per triangle, in vertex order (empty: flat shading)
   std::vector<MediumStack> emitter_media;  // per emitter: the solids its light starts in (innermost on top)
 
@@ -78,6 +79,10 @@ struct Tracer::Impl {
     // 1e-5 of the luminaire's diagonal (5 µm for a 0.5 m luminaire): far above float rounding of positions
     // (2⁻²⁴ relative), far below any wall thickness a luminaire is modelled with.
     offset_scale = 1e-5 * std::max(extent, 1e-3);
+    // Embree intersects in float: a luminaire placed 10⁵ m from the origin would be resolved to 8 mm there.
+    // Its vertices and every ray origin are therefore given to Embree relative to the box centre, where
+    // float resolves the luminaire to 2⁻²⁴ of its size wherever it is placed.
+    if (!s.positions.empty()) frame_origin = 0.5 * (lo + hi);
 
     device = rtcNewDevice(nullptr);
     if (!device) throw std::runtime_error("Embree: rtcNewDevice failed");
@@ -88,9 +93,9 @@ struct Tracer::Impl {
       // sharing one vertex buffer (padded: Embree reads 16 bytes at the last vertex).
       vertices.resize(3 * s.positions.size() + 1);
       for (std::size_t i = 0; i < s.positions.size(); ++i) {
-        vertices[3 * i] = s.positions[i].x;
-        vertices[3 * i + 1] = s.positions[i].y;
-        vertices[3 * i + 2] = s.positions[i].z;
+        vertices[3 * i] = float(double(s.positions[i].x) - frame_origin.x);
+        vertices[3 * i + 1] = float(double(s.positions[i].y) - frame_origin.y);
+        vertices[3 * i + 2] = float(double(s.positions[i].z) - frame_origin.z);
       }
       for (std::size_t p = 0; p < s.parts.size(); ++p) {
         const Part& part = s.parts[p];
@@ -172,7 +177,8 @@ struct Tracer::Impl {
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     RTCRayHit rh;
-    rh.ray.org_x = float(origin.x), rh.ray.org_y = float(origin.y), rh.ray.org_z = float(origin.z);
+    const glm::dvec3 local = origin - frame_origin;
+    rh.ray.org_x = float(local.x), rh.ray.org_y = float(local.y), rh.ray.org_z = float(local.z);
     rh.ray.dir_x = float(direction.x), rh.ray.dir_y = float(direction.y), rh.ray.dir_z = float(direction.z);
     rh.ray.tnear = 0.0f;
     rh.ray.tfar = std::numeric_limits<float>::infinity();
@@ -197,11 +203,33 @@ struct Tracer::Impl {
     if (device) rtcReleaseDevice(device);
   }
 
+  /// Self-intersection distance at p: the scene's scale, or 8 float steps of p's largest coordinate in
+  /// Embree's frame where that is more (Embree intersects in float, so a triangle is only known to about
+  /// one step of its coordinates there; for points of the luminaire the scale term always dominates).
+  double offset_eps(const glm::dvec3& world) const {
+    const glm::dvec3 p = world - frame_origin;
+    const double magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    return offset_scale + 8.0 * FLT_EPSILON * magnitude;
+  }
+
   /// Origin moved off the surface at p (geometric normal ng) to the side direction d leaves on.
   glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d) const {
-    const double magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-    const double eps = offset_scale + 64.0 * FLT_EPSILON * magnitude;
+    const double eps = offset_eps(p);
     return p + (glm::dot(d, ng) >= 0.0 ? eps : -eps) * ng;
+  }
+
+  /// Origin of the next segment after the hit p = origin + t·d_in, leaving along d_out. A reflection steps
+  /// back along the incoming segment, which Embree found free of surfaces, to the distance eps from the
+  /// surface: at a concave edge an offset along one face's normal would stay in the other face's plane (or
+  /// cross it, for an angle below 90°), and a ray along that face would then pass through it. Where the
+  /// segment is too short or too grazing for that, and for transmission, the origin moves along the normal.
+  glm::dvec3 next_origin(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d_in, double t,
+                         const glm::dvec3& d_out) const {
+    const double eps = offset_eps(p);
+    const double in = glm::dot(d_in, ng), out = glm::dot(d_out, ng);
+    const bool reflected = (in < 0.0) == (out > 0.0);
+    if (reflected && std::abs(in) > 0.0 && eps / std::abs(in) <= 0.5 * t) return p - (eps / std::abs(in)) * d_in;
+    return offset_origin(p, ng, d_out);
   }
 
   void trace_particle(std::uint64_t index, const TraceOptions& o, double particle_flux, ParticleChunk& out,
@@ -362,7 +390,7 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
       beta /= q;
     }
 
-    origin = offset_origin(position, ng, wi);
+    origin = next_origin(position, ng, direction, t, wi);
     direction = wi;
   }
 }
