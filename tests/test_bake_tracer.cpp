@@ -546,6 +546,48 @@ TEST(BakeTracer, ClosedBoxesAreWatertightAtEdgesVerticesAndFarFromTheOrigin) {
   std::filesystem::remove_all(dir);
 }
 
+// A clear glass slab 0.1 mm thick (a closed box, 0.2 × 0.2 × 1e-4 m) under a point light (hard-cases.md §6
+// item 47, "planes 1e-4 apart"). Light can reach the underside only through both faces: every particle
+// that leaves downwards has scattered at least twice, and one that crossed with exactly two refractions
+// leaves parallel to the ray it arrived on, displaced by less than the slab's thickness times the tangent
+// of the refraction angle (< 1e-4 · 1.2 here), so its backward line passes that close to the light. A ray
+// that skipped the second face (an offset beyond 0.1 mm) would leave bent, after one scattering event.
+TEST(BakeTracer, ThinGlassSlabIsCrossedFaceByFace) {
+  SceneBuilder b("thin slab");
+  b.begin_part("slab", b.add_material(smooth_glass(1.5, 1.0, 1.0)));
+  const double half_thickness = 5e-5;
+  b.box(glm::dmat4(1.0), {0.1, 0.1, half_thickness}, /*outward=*/true);
+  const glm::dvec3 light(0.0, 0.0, 0.05);
+  b.point_light(light, 1.0);
+  const Tracer tracer(b.scene());
+  const Trace t = run(tracer, 40000);
+  EXPECT_EQ(t.counters.leaked, 0u);
+  std::size_t down = 0, straight = 0;
+  double worst = 0;
+  for (const ExitParticle& x : t.sink.exits) {
+    if (x.direction.z >= 0 || x.position.z > 0) continue;  // the upper half space: reflected or never hit
+    ++down;
+    EXPECT_GE(x.bounces, 2u);
+    if (x.bounces != 2 || std::abs(x.position.x) > 0.099 || std::abs(x.position.y) > 0.099) continue;
+    ++straight;
+    const glm::dvec3 p(x.position), d = glm::normalize(glm::dvec3(x.direction));
+    const glm::dvec3 to_light = light - p;
+    const double miss = glm::length(to_light - glm::dot(to_light, -d) * -d);  // distance of the light from the line
+    worst = std::max(worst, miss);
+    EXPECT_LT(miss, 1.2e-4 * 2 * half_thickness / 1e-4 + 1e-5) << x.direction.x << ' ' << x.direction.y << ' ' << x.direction.z;
+  }
+  std::printf("thin slab: %zu of %zu exits below, %zu straight through, worst distance of the light from their line %.3g m\n",
+              down, t.sink.exits.size(), straight, worst);
+  EXPECT_GT(straight, 1000u);
+  // Energy: the glass absorbs nothing; what is not capped (trapped by total internal reflection) leaves.
+  // Smooth glass is sampled by its Fresnel reflectance with weight 1, so nothing is absorbed or lost to
+  // roulette, and the sum is exact up to rounding.
+  EXPECT_EQ(t.counters.absorbed, 0u);
+  EXPECT_EQ(t.counters.roulette_killed, 0u);
+  const double phi = 4 * lumx::kPi;
+  EXPECT_NEAR(t.counters.exited_lm + double(t.counters.depth_capped) * phi / 40000.0, phi, 1e-6 * phi);
+}
+
 TEST(BakeTracer, LuminaireWithoutFluxIsRefusedByName) {
   SceneBuilder b("dark");
   b.begin_part("box", b.add_material(black()));
