@@ -2,7 +2,7 @@
 // Copyright Contributors to the lumx project.
 // src/bake/path_state.h — what a path through a luminaire carries from one hit to the next, shared by the
 // particle tracer (bake/tracer.cpp) and the eye paths of the appearance renderer (render/appearance.cpp):
-// the shading frame at a hit and the stack of solids the path is inside.
+// the shading frame at a hit, the stack of solids the path is inside, and where its next ray starts.
 #pragma once
 
 #include <lumx/version.h>
@@ -10,6 +10,8 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -17,6 +19,47 @@
 
 LUMX_NAMESPACE_BEGIN
 namespace bake::detail {
+
+/// Where rays start, for a luminaire whose box is [lo, hi]. Embree intersects in float, so vertices and ray
+/// origins are given to it relative to the box centre (`to_embree`): a luminaire 10⁵ m from the origin is
+/// resolved as finely as one at it. A new ray starts ε off the surface it leaves: 10⁻⁵ of the diagonal (5 µm
+/// for a 0.5 m luminaire), far above float rounding of the vertices, far below any modelled wall.
+struct RayStarts {
+  glm::dvec3 centre{0.0};
+  double scale = 1e-6;  // m
+
+  RayStarts() = default;
+  RayStarts(const glm::dvec3& lo, const glm::dvec3& hi)
+      : centre(0.5 * (lo + hi)), scale(1e-5 * std::max(glm::length(hi - lo), 1e-3)) {}
+
+  glm::vec3 to_embree(const glm::dvec3& world) const { return glm::vec3(world - centre); }
+
+  /// ε at p: the scale, or 8 float steps of p's largest coordinate in Embree's frame where that is more.
+  double eps(const glm::dvec3& world) const {
+    const glm::dvec3 p = world - centre;
+    return scale + 8.0 * FLT_EPSILON * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  }
+
+  /// p moved ε along the geometric normal ng to the side direction d leaves on.
+  glm::dvec3 off_surface(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d) const {
+    const double e = eps(p);
+    return p + (glm::dot(d, ng) >= 0.0 ? e : -e) * ng;
+  }
+
+  /// Start of the next ray after the hit p = origin + t·d_in, leaving along d_out. A reflection steps back
+  /// along the arriving segment, which Embree found free of surfaces, to the distance ε from the surface:
+  /// at a concave edge an offset along one face's normal stays in the other face's plane (or crosses it,
+  /// below 90°), which the next ray could then pass through. A transmission, or a reflection after a
+  /// segment too short or too grazing for that, moves along the normal.
+  glm::dvec3 after_hit(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d_in, double t,
+                       const glm::dvec3& d_out) const {
+    const double e = eps(p);
+    const double in = glm::dot(d_in, ng), out = glm::dot(d_out, ng);
+    const bool reflected = (in < 0.0) == (out > 0.0);
+    if (reflected && std::abs(in) > 0.0 && e / std::abs(in) <= 0.5 * t) return p - (e / std::abs(in)) * d_in;
+    return off_surface(p, ng, d_out);
+  }
+};
 
 /// Orthonormal basis around unit n (Duff et al. 2017, "Building an Orthonormal Basis, Revisited", JCGT 6(1)).
 struct Frame {

@@ -43,6 +43,7 @@ double max_component(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 
 using detail::Frame;
 using detail::MediumStack;
+using detail::RayStarts;
 using detail::shading_normal;
 
 }  // namespace
@@ -55,10 +56,9 @@ struct Tracer::Impl {
   std::vector<Rgb> absorption;             // per material, 1/m
   std::vector<std::uint8_t> part_volume;   // per part: its material is a closed solid
   EmitterSampler emitters;
-  double offset_scale = 1e-6;              // self-intersection offset, m (from the scene's extent)
+  RayStarts starts;                         // Embree's frame and the self-intersection offset
 
-  glm::dvec3 frame_origin{0.0};             // Embree works relative to the luminaire's box centre (below)
-  std::vector<float> vertices;              // Embree's shared vertex buffer, relative to frame_origin
+  std::vector<float> vertices;              // Embree's shared vertex buffer, in its frame (RayStarts)
   std::vector<glm::vec3> triangle_normals;  // 3 per triangle, in vertex order (empty: flat shading)
   std::vector<MediumStack> emitter_media;  // per emitter: the solids its light starts in (innermost on top)
 
@@ -75,14 +75,7 @@ struct Tracer::Impl {
       lo = glm::min(lo, glm::dvec3(p));
       hi = glm::max(hi, glm::dvec3(p));
     }
-    const double extent = s.positions.empty() ? 1.0 : glm::length(hi - lo);
-    // 1e-5 of the luminaire's diagonal (5 µm for a 0.5 m luminaire): far above float rounding of positions
-    // (2⁻²⁴ relative), far below any wall thickness a luminaire is modelled with.
-    offset_scale = 1e-5 * std::max(extent, 1e-3);
-    // Embree intersects in float: a luminaire placed 10⁵ m from the origin would be resolved to 8 mm there.
-    // Its vertices and every ray origin are therefore given to Embree relative to the box centre, where
-    // float resolves the luminaire to 2⁻²⁴ of its size wherever it is placed.
-    if (!s.positions.empty()) frame_origin = 0.5 * (lo + hi);
+    if (!s.positions.empty()) starts = RayStarts(lo, hi);
 
     device = rtcNewDevice(nullptr);
     if (!device) throw std::runtime_error("Embree: rtcNewDevice failed");
@@ -93,9 +86,10 @@ struct Tracer::Impl {
       // sharing one vertex buffer (padded: Embree reads 16 bytes at the last vertex).
       vertices.resize(3 * s.positions.size() + 1);
       for (std::size_t i = 0; i < s.positions.size(); ++i) {
-        vertices[3 * i] = float(double(s.positions[i].x) - frame_origin.x);
-        vertices[3 * i + 1] = float(double(s.positions[i].y) - frame_origin.y);
-        vertices[3 * i + 2] = float(double(s.positions[i].z) - frame_origin.z);
+        const glm::vec3 v = starts.to_embree(glm::dvec3(s.positions[i]));
+        vertices[3 * i] = v.x;
+        vertices[3 * i + 1] = v.y;
+        vertices[3 * i + 2] = v.z;
       }
       for (std::size_t p = 0; p < s.parts.size(); ++p) {
         const Part& part = s.parts[p];
@@ -131,7 +125,7 @@ struct Tracer::Impl {
         const glm::dvec3 n = glm::cross(b - a, c - a);
         if (!(glm::length(n) > 0.0)) continue;
         const glm::dvec3 centroid = (a + b + c) / 3.0, nn = glm::normalize(n);
-        emitter_media[e] = media_at(offset_origin(centroid, nn, nn), std::uint32_t(part.material));
+        emitter_media[e] = media_at(starts.off_surface(centroid, nn, nn), std::uint32_t(part.material));
       } else {
         emitter_media[e] = media_at(glm::dvec3(em.to_world[3]), std::uint32_t(-1));
       }
@@ -162,9 +156,9 @@ struct Tracer::Impl {
           else if (found.size < MediumStack::kCapacity)
             found.part[found.size++] = part;  // outward order: innermost first
         }
-        o = offset_origin(hit, ng, d);
+        o = starts.off_surface(hit, ng, d);
       } else {
-        o = hit + offset_scale * d;
+        o = hit + starts.scale * d;
       }
     }
     MediumStack stack;  // innermost on top
@@ -177,8 +171,8 @@ struct Tracer::Impl {
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     RTCRayHit rh;
-    const glm::dvec3 local = origin - frame_origin;
-    rh.ray.org_x = float(local.x), rh.ray.org_y = float(local.y), rh.ray.org_z = float(local.z);
+    const glm::vec3 local = starts.to_embree(origin);
+    rh.ray.org_x = local.x, rh.ray.org_y = local.y, rh.ray.org_z = local.z;
     rh.ray.dir_x = float(direction.x), rh.ray.dir_y = float(direction.y), rh.ray.dir_z = float(direction.z);
     rh.ray.tnear = 0.0f;
     rh.ray.tfar = std::numeric_limits<float>::infinity();
@@ -201,35 +195,6 @@ struct Tracer::Impl {
   ~Impl() {
     if (rtc_scene) rtcReleaseScene(rtc_scene);
     if (device) rtcReleaseDevice(device);
-  }
-
-  /// Self-intersection distance at p: the scene's scale, or 8 float steps of p's largest coordinate in
-  /// Embree's frame where that is more (Embree intersects in float, so a triangle is only known to about
-  /// one step of its coordinates there; for points of the luminaire the scale term always dominates).
-  double offset_eps(const glm::dvec3& world) const {
-    const glm::dvec3 p = world - frame_origin;
-    const double magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-    return offset_scale + 8.0 * FLT_EPSILON * magnitude;
-  }
-
-  /// Origin moved off the surface at p (geometric normal ng) to the side direction d leaves on.
-  glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d) const {
-    const double eps = offset_eps(p);
-    return p + (glm::dot(d, ng) >= 0.0 ? eps : -eps) * ng;
-  }
-
-  /// Origin of the next segment after the hit p = origin + t·d_in, leaving along d_out. A reflection steps
-  /// back along the incoming segment, which Embree found free of surfaces, to the distance eps from the
-  /// surface: at a concave edge an offset along one face's normal would stay in the other face's plane (or
-  /// cross it, for an angle below 90°), and a ray along that face would then pass through it. Where the
-  /// segment is too short or too grazing for that, and for transmission, the origin moves along the normal.
-  glm::dvec3 next_origin(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d_in, double t,
-                         const glm::dvec3& d_out) const {
-    const double eps = offset_eps(p);
-    const double in = glm::dot(d_in, ng), out = glm::dot(d_out, ng);
-    const bool reflected = (in < 0.0) == (out > 0.0);
-    if (reflected && std::abs(in) > 0.0 && eps / std::abs(in) <= 0.5 * t) return p - (eps / std::abs(in)) * d_in;
-    return offset_origin(p, ng, d_out);
   }
 
   void trace_particle(std::uint64_t index, const TraceOptions& o, double particle_flux, ParticleChunk& out,
@@ -258,7 +223,7 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
 
   glm::dvec3 position = e.position;
   glm::dvec3 direction = e.direction;
-  glm::dvec3 origin = e.has_surface ? offset_origin(e.position, e.surface_normal, e.direction) : e.position;
+  glm::dvec3 origin = e.has_surface ? starts.off_surface(e.position, e.surface_normal, e.direction) : e.position;
   // Rayset rays start anywhere: find their solids per particle; other emitters sit in fixed ones.
   MediumStack media = scene.emitters[e.emitter].kind == EmitterKind::rayset ? media_at(e.position, std::uint32_t(-1))
                                                                            : emitter_media[e.emitter];
@@ -318,7 +283,7 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
     const double ng_len = glm::length(ng);
     position = origin + t * direction;
     if (!(ng_len > 0.0) || !std::isfinite(ng_len)) {  // degenerate triangle: pass straight through
-      origin = position + offset_scale * direction;
+      origin = position + starts.scale * direction;
       continue;
     }
     ng /= ng_len;
@@ -390,7 +355,7 @@ void Tracer::Impl::trace_particle(std::uint64_t index, const TraceOptions& o, do
       beta /= q;
     }
 
-    origin = next_origin(position, ng, direction, t, wi);
+    origin = starts.after_hit(position, ng, direction, t, wi);
     direction = wi;
   }
 }

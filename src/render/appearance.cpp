@@ -46,6 +46,7 @@ bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v
 
 using bake::detail::Frame;
 using bake::detail::MediumStack;
+using bake::detail::RayStarts;
 using bake::detail::shading_normal;
 
 /// Power heuristic with β = 2 (Veach 1997 §9.2.4).
@@ -101,7 +102,7 @@ struct AppearanceRenderer::Impl {
   std::vector<std::uint8_t> has_smooth_lobes_only;
   std::vector<float> vertices;
   std::vector<glm::vec3> triangle_normals;
-  double offset_scale = 1e-6;
+  RayStarts starts;  // Embree's frame and the self-intersection offset, as the tracer's
   Aabb box;
   // Surface emitters for next-event estimation: emissive triangles ∝ luminance × area.
   std::vector<std::uint32_t> emissive_triangles;
@@ -127,8 +128,7 @@ struct AppearanceRenderer::Impl {
       box.lo = glm::min(box.lo, glm::dvec3(p));
       box.hi = glm::max(box.hi, glm::dvec3(p));
     }
-    // As the tracer: 1e-5 of the diagonal, far above float rounding, far below any wall thickness.
-    offset_scale = 1e-5 * std::max(glm::length(box.hi - box.lo), 1e-3);
+    starts = RayStarts(box.lo, box.hi);
 
     device = rtcNewDevice(nullptr);
     if (!device) throw std::runtime_error("Embree: rtcNewDevice failed");
@@ -136,9 +136,10 @@ struct AppearanceRenderer::Impl {
     rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
     vertices.resize(3 * s.positions.size() + 1);  // padded: Embree reads 16 bytes at the last vertex
     for (std::size_t i = 0; i < s.positions.size(); ++i) {
-      vertices[3 * i] = s.positions[i].x;
-      vertices[3 * i + 1] = s.positions[i].y;
-      vertices[3 * i + 2] = s.positions[i].z;
+      const glm::vec3 q = starts.to_embree(glm::dvec3(s.positions[i]));
+      vertices[3 * i] = q.x;
+      vertices[3 * i + 1] = q.y;
+      vertices[3 * i + 2] = q.z;
     }
     for (std::size_t p = 0; p < s.parts.size(); ++p) {  // geomID = part index, as in the tracer
       const bake::Part& part = s.parts[p];
@@ -208,7 +209,8 @@ struct AppearanceRenderer::Impl {
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     RTCRayHit rh;
-    rh.ray.org_x = float(origin.x), rh.ray.org_y = float(origin.y), rh.ray.org_z = float(origin.z);
+    const glm::vec3 local = starts.to_embree(origin);
+    rh.ray.org_x = local.x, rh.ray.org_y = local.y, rh.ray.org_z = local.z;
     rh.ray.dir_x = float(direction.x), rh.ray.dir_y = float(direction.y), rh.ray.dir_z = float(direction.z);
     rh.ray.tnear = 0.0f;
     rh.ray.tfar = tfar;
@@ -227,7 +229,8 @@ struct AppearanceRenderer::Impl {
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     RTCRay ray;
-    ray.org_x = float(origin.x), ray.org_y = float(origin.y), ray.org_z = float(origin.z);
+    const glm::vec3 local = starts.to_embree(origin);
+    ray.org_x = local.x, ray.org_y = local.y, ray.org_z = local.z;
     ray.dir_x = float(direction.x), ray.dir_y = float(direction.y), ray.dir_z = float(direction.z);
     ray.tnear = 0.0f;
     ray.tfar = float(distance);
@@ -236,12 +239,6 @@ struct AppearanceRenderer::Impl {
     ray.flags = 0;
     rtcOccluded1(rtc_scene, &context, &ray);
     return ray.tfar < 0.0f;
-  }
-
-  glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d) const {
-    const double magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-    const double eps = offset_scale + 64.0 * FLT_EPSILON * magnitude;
-    return p + (glm::dot(d, ng) >= 0.0 ? eps : -eps) * ng;
   }
 
   glm::dvec3 triangle_vertex(std::size_t t, int k) const { return glm::dvec3(scene.positions[scene.indices[3 * t + k]]); }
@@ -276,9 +273,9 @@ struct AppearanceRenderer::Impl {
       wi_side = wi_local;
       // The geometric and shading sides must agree (no light through the surface by its shading normal).
       if ((glm::dot(wi, ng) > 0.0) != (wi_local.z > 0.0)) return false;
-      const glm::dvec3 origin = offset_origin(p, ng, wi);
+      const glm::dvec3 origin = starts.off_surface(p, ng, wi);
       counters.rays += 1;
-      return !occluded(origin, wi, distance * (1.0 - 1e-4) - offset_scale);
+      return !occluded(origin, wi, distance * (1.0 - 1e-4) - starts.scale);
     };
 
     const double u_light = rng.next_double(), u1 = rng.next_double(), u2 = rng.next_double();
@@ -355,7 +352,7 @@ struct AppearanceRenderer::Impl {
       glm::dvec3 ng{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
       const double ng_len = glm::length(ng);
       if (!(ng_len > 0.0) || !std::isfinite(ng_len)) {  // degenerate triangle: pass straight through
-        origin = position + offset_scale * direction;
+        origin = position + starts.scale * direction;
         continue;
       }
       ng /= ng_len;
@@ -447,7 +444,7 @@ struct AppearanceRenderer::Impl {
         beta /= q;
       }
       previous = position;
-      origin = offset_origin(position, ng, wi);
+      origin = starts.after_hit(position, ng, direction, t, wi);
       direction = wi;
     }
   }
