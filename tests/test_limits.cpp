@@ -457,5 +457,17 @@ TEST(Robustness, Hostile100MBManifestIsRefusedInBoundedTimeAndMemory) {
   EXPECT_EQ(r.byte_offset, 256) << r.message;
   EXPECT_LT(r.seconds, 5.0 * kSlow);
   EXPECT_LT(r.grown_kb, kFileKb + 16 * 1024 + kSanitizerKb);
+  // A manifest that is one 2 GiB string (hard-cases.md §6 item 30; a sparse file, so the test writes 12
+  // bytes): refused from its size, nothing read, whatever the string holds.
+  {
+    std::ofstream f(b / "manifest.json", std::ios::binary | std::ios::trunc);
+    f << "{\"format\": \"";
+  }
+  fs::resize_file(b / "manifest.json", (std::uint64_t(2) << 30) + 2);
+  r = run_bounded([&] { BundleReader reader(b.string()); });
+  EXPECT_TRUE(r.threw);
+  EXPECT_NE(r.message.find("BundleLimits::max_manifest_bytes"), std::string::npos) << r.message;
+  EXPECT_LT(r.seconds, 1.0 * kSlow);
+  EXPECT_LT(r.grown_kb, 8 * 1024 + kSanitizerKb);
   fs::remove_all(d);
 }
