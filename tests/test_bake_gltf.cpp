@@ -4,11 +4,14 @@
 // synthetic files written here (transforms, materials, every emitter kind and its flux, extensions, bad
 // input with the exact JSON pointer or byte offset) and the real flower pendant in ../shared, plain and Draco.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "gltf_test_support.h"
 #include "test_support.h"
 
 #include <lumx/bake/gltf_reader.h>
+#include <lumx/bake/gltf_writer.h>
+#include <lumx/bake/luminaire_builder.h>
 #include <lumx/bake/luminaire_check.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/photometry/intensity_table.h>
@@ -17,6 +20,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <random>
@@ -694,6 +698,61 @@ TEST(GltfBadInput, CorruptDracoPayloadsAreLocatedErrors) {
     EXPECT_EQ(e.diagnostic().field, "/accessors/0/count");
     EXPECT_NE(e.diagnostic().message.find("GltfReadOptions::max_vertices (3)"), std::string::npos) << e.what();
   }
+}
+
+// A Draco payload that decodes, but to other counts than its accessors declare (hard-cases.md §6 item 24):
+// the POSITION accessor's count one more or one fewer than the decoded mesh's vertices, and the indices
+// accessor's likewise, are errors at those accessors; the untouched file reads.
+TEST(GltfBadInput, DracoCountsThatDisagreeWithTheAccessorsAreLocatedErrors) {
+  const auto dir = lumx_gltf_test::scratch_dir("draco_counts");
+  bake::LuminaireBuilder b("box");
+  bake::Material m;
+  m.emissive = bake::Rgb{1.0};
+  b.begin_part("box", b.add_material(m));
+  b.box(glm::dmat4(1.0), {0.1, 0.05, 0.02});
+  bake::GltfWriteOptions o;
+  o.draco = true;
+  const fs::path good = dir / "good.glb";
+  bake::write_gltf_luminaire(b.scene(), good.string(), o);
+  ASSERT_NO_THROW(bake::read_gltf_luminaire(good.string()));
+  // Split the GLB, edit its JSON, pack it again with correct chunk lengths.
+  const std::string bytes = lumx_test::read_text(good);
+  auto u32 = [&](std::size_t at) {
+    return std::uint32_t(std::uint8_t(bytes[at])) | std::uint32_t(std::uint8_t(bytes[at + 1])) << 8 |
+           std::uint32_t(std::uint8_t(bytes[at + 2])) << 16 | std::uint32_t(std::uint8_t(bytes[at + 3])) << 24;
+  };
+  const std::uint32_t json_length = u32(12);
+  const nlohmann::json doc = nlohmann::json::parse(bytes.substr(20, json_length));
+  const std::string bin_chunk = bytes.substr(20 + json_length);  // header and data of the BIN chunk
+  auto pack = [&](const nlohmann::json& d, const fs::path& path) {
+    std::string json = d.dump();
+    while (json.size() % 4) json += ' ';
+    std::string out = "glTF";
+    auto put = [&out](std::uint32_t v) {
+      for (int k = 0; k < 4; ++k) out += char(v >> (8 * k));
+    };
+    put(2);
+    put(std::uint32_t(12 + 8 + json.size() + bin_chunk.size()));
+    put(std::uint32_t(json.size()));
+    put(0x4E4F534Au);
+    out += json + bin_chunk;
+    std::ofstream(path, std::ios::binary) << out;
+  };
+  const nlohmann::json& primitive = doc["meshes"][0]["primitives"][0];
+  ASSERT_TRUE(primitive["extensions"].contains("KHR_draco_mesh_compression"));
+  const int position = primitive["attributes"]["POSITION"], indices = primitive["indices"];
+  for (const int accessor : {position, indices})
+    for (const int delta : {-1, +1}) {
+      nlohmann::json d = doc;
+      d["accessors"][accessor]["count"] = d["accessors"][accessor]["count"].get<int>() + delta * (accessor == indices ? 3 : 1);
+      const fs::path path = dir / ("count" + std::to_string(accessor) + "_" + std::to_string(delta) + ".glb");
+      pack(d, path);
+      const lumx::Diagnostic e = read_error(path);
+      EXPECT_EQ(e.field, "/accessors/" + std::to_string(accessor) + "/count") << e.str();
+      EXPECT_NE(e.message.find("Draco mesh has"), std::string::npos) << e.str();
+    }
+  pack(doc, dir / "repacked.glb");
+  EXPECT_NO_THROW(bake::read_gltf_luminaire((dir / "repacked.glb").string()));
 }
 
 namespace {
