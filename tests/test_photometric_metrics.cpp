@@ -3,6 +3,7 @@
 // Zonal lumens, CIE flux code, BUG rating, spacing criterion, luminance table, the isolux grid and the
 // cone diagram, against distributions whose values are known in closed form (isotropic, cosine, cos^n)
 // and against the real files of ../shared.
+#include "analytic_emitters.h"
 #include "metrics_test_support.h"
 #include "test_support.h"
 
@@ -181,6 +182,29 @@ TEST(IlluminanceGrid, InverseSquareCosineOfAPointSource) {
     IlluminanceGridOptions z;
     z.mounting_height_m = bad;
     EXPECT_THROW(illuminance_grid(t, z), std::invalid_argument) << bad;
+  }
+}
+
+// The far-field (inverse-square) model of a Lambertian disk of diameter D against the disk's exact field
+// (hard-cases.md §6 item 45; the photometric five-times rule): on the axis the point model overestimates by
+// exactly (a/h)², 1 % at h = 5 D and 0.25 % at 10 D; off the axis, within the same bound up to 60°.
+TEST(IlluminanceGrid, DiskFarFieldIsWithinOnePercentBeyondFiveDiameters) {
+  const double a = 0.1, flux = 1000.0;  // radius, m; lm
+  const lumx_test::PlanarEmitter disk("disk", lumx_test::PlanarEmitter::Shape::disk, a, 0.0, 1.0, flux);
+  const IntensityTable t(lumx_test::rotational_photometry(
+      [&](double g) { return g < 90 ? flux / kPi * std::cos(g * kDegToRad) : 0.0; }, 0.5, 0.0, 0.0));
+  for (const double diameters : {5.0, 10.0}) {
+    const double h = diameters * 2 * a, bound = (a / h) * (a / h);
+    for (const double off_deg : {0.0, 20.0, 40.0, 60.0}) {
+      const double x = h * std::tan(off_deg * kDegToRad);
+      const double exact = disk.irradiance({x, 0.0, h}, {0.0, 0.0, -1.0});  // the disk faces +z, the plane −z
+      const double far = illuminance_lx(t, x, 0.0, h, 0.0);
+      const double rel = far / exact - 1;
+      EXPECT_LE(std::abs(rel), bound * 1.01) << diameters << " D, " << off_deg << "°";
+      if (off_deg == 0.0) {
+        EXPECT_NEAR(rel, bound, 1e-3 * bound) << diameters << " D";  // (h² + a²)/h² − 1
+      }
+    }
   }
 }
 
