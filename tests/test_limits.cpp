@@ -12,6 +12,7 @@
 #include <lumx/io/tm33_io.h>
 
 #include <gtest/gtest.h>
+#include <lumx/io/image_io.h>
 
 #include "io/bundle/exr_image.h"
 #include "rayset_test_support.h"
@@ -319,6 +320,43 @@ TEST(Robustness, ExrAttributeLargerThanThePayloadIsRefusedBeforeOpenExrAllocates
   const std::string good =
       lumx_test::read_text(lumx_test::data_dir() / "fuzz" / "bundle" / "level00_n00001_r0008.exr");
   EXPECT_EQ(detail::decode_exr(good, "good.exr", 16, 8, {"Y"}).pixels.size(), 128u);
+}
+
+TEST(Robustness, ExrHeadersOpenExrWouldReadElsewhereAreRefused) {
+  // Found by fuzz_bundle (exr_chlist_desync.exr, 465 bytes): a channel list that does not end where its
+  // size says made OpenEXR read the next attribute at another offset, whose bytes became a 1.9 GB size.
+  const std::string exr = lumx_test::read_text(lumx_test::data_dir() / "fuzz" / "bundle" / "exr_chlist_desync.exr");
+  Bounded r = run_bounded([&] { (void)detail::decode_exr(exr, "a.exr", 16, 8, {"Y"}); });
+  EXPECT_TRUE(r.threw);
+  // Its second channel's name starts at byte 46 and runs past the list's declared 19 bytes.
+  EXPECT_EQ(r.byte_offset, 46) << r.message;
+  EXPECT_NE(r.message.find("channel name is not terminated"), std::string::npos) << r.message;
+  EXPECT_LT(r.seconds, 1.0 * kSlow);
+  EXPECT_LT(r.grown_kb, 8 * 1024 + kSanitizerKb);
+  // A payload lumx wrote, with the data window's size field (box2i: 16 bytes) changed to 4 and to 20.
+  const std::string good =
+      lumx_test::read_text(lumx_test::data_dir() / "fuzz" / "bundle" / "level00_n00001_r0008.exr");
+  const std::size_t type = good.find(std::string("dataWindow\0box2i\0", 17));
+  ASSERT_NE(type, std::string::npos);
+  for (const char size : {char(4), char(20)}) {
+    std::string bad = good;
+    bad[type + 17] = size;
+    try {
+      (void)detail::decode_exr(bad, "b.exr", 16, 8, {"Y"});
+      ADD_FAILURE() << "a box2i of " << int(size) << " bytes was read";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.diagnostic().byte_offset, std::int64_t(type + 17)) << e.what();
+      EXPECT_NE(std::string(e.what()).find("its type has 16"), std::string::npos) << e.what();
+    }
+  }
+  // The same checks guard read_exr_image (any EXR, not only a bundle's): the 2 GiB attribute is refused.
+  const fs::path d = fresh_dir("exr_image");
+  const fs::path huge = d / "huge_attribute.exr";
+  std::ofstream(huge, std::ios::binary) << lumx_test::read_text(lumx_test::data_dir() / "fuzz" / "bundle" / "exr_attribute_2gib.exr");
+  r = run_bounded([&] { (void)read_exr_image(huge.string()); });
+  EXPECT_TRUE(r.threw);
+  EXPECT_LT(r.grown_kb, 8 * 1024 + kSanitizerKb);
+  fs::remove_all(d);
 }
 
 TEST(Robustness, RefusedBundlesLeaveNoFileDescriptorOpen) {

@@ -64,9 +64,15 @@ class MemoryIStream : public Imf::IStream {
   throw_at_field(file, field, message);
 }
 
-/// Walks the header's attributes before OpenEXR parses them: OpenEXR allocates (and clears) each attribute's
-/// declared size before it reads the value, so a 100-byte payload declaring a 2 GB attribute would cost
-/// 2 GB. Every size must fit in the bytes that follow; lumx writes single-part scanline images only.
+/// Walks the header's attributes before OpenEXR parses them, so that OpenEXR can only read what the header
+/// describes consistently. OpenEXR allocates (and clears) an attribute's declared size before it reads the
+/// value (a 29-byte payload declaring a 2 GiB attribute would cost 2 GiB), and it reads typed attributes by
+/// their content: a fixed-size type declared with another size, or a channel list that does not end where
+/// its size says, leaves OpenEXR reading the next attribute at another offset than the header's, where any
+/// bytes become a size (found by fuzz_bundle: 1.9 GB for a 465-byte payload). So: every size must fit in
+/// the bytes that follow; fixed-size types must have their size; a channel list, a string vector and a
+/// preview image must fill their declared size exactly; ID manifests (compressed) are refused. Single-part
+/// scanline images only. Unknown types are read by OpenEXR as opaque bytes of the declared size.
 void check_exr_header(std::string_view b, const std::string& file) {
   const auto u32 = [&](std::size_t at) {
     return std::uint32_t(std::uint8_t(b[at])) | std::uint32_t(std::uint8_t(b[at + 1])) << 8 |
@@ -77,26 +83,63 @@ void check_exr_header(std::string_view b, const std::string& file) {
   if (flags & ~0x400u)  // anything but long attribute names: tiled, deep or multi-part
     throw_at_offset(file, 4, "OpenEXR", "not a single-part scanline image (version flags " + std::to_string(flags) + ")");
   std::size_t at = 8;
-  const auto zero_terminated = [&](const char* what) {
-    const std::size_t end = b.find('\0', at);
-    if (end == std::string_view::npos || end - at > 255)
-      throw_at_offset(file, std::int64_t(at), "OpenEXR header", std::string(what) + " is not terminated");
-    const std::string_view s = b.substr(at, end - at);
-    at = end + 1;
+  const auto zero_terminated = [&](std::size_t& pos, std::size_t end, const char* what) {
+    const std::size_t stop = b.substr(0, end).find('\0', pos);
+    if (stop == std::string_view::npos || stop - pos > 255)
+      throw_at_offset(file, std::int64_t(pos), "OpenEXR header", std::string(what) + " is not terminated");
+    const std::string_view s = b.substr(pos, stop - pos);
+    pos = stop + 1;
     return s;
   };
+  // OpenEXR 3.1's fixed-size attribute types (ImfStandardAttributes and the typed attributes it registers).
+  static const std::pair<std::string_view, std::uint32_t> kFixed[] = {
+      {"box2i", 16},    {"box2f", 16},  {"compression", 1}, {"chromaticities", 32}, {"double", 8}, {"envmap", 1},
+      {"float", 4},     {"int", 4},     {"keycode", 28},    {"lineOrder", 1},       {"m33f", 36},  {"m33d", 72},
+      {"m44f", 64},     {"m44d", 128},  {"rational", 8},    {"tiledesc", 9},        {"timecode", 8}, {"v2i", 8},
+      {"v2f", 8},       {"v2d", 16},    {"v3i", 12},        {"v3f", 12},            {"v3d", 24},   {"deepImageState", 1}};
   for (int n = 0;; ++n) {
     if (n > 1024) throw_at_offset(file, std::int64_t(at), "OpenEXR header", "more than 1024 attributes");
-    const std::string_view name = zero_terminated("attribute name");
+    const std::string_view name = zero_terminated(at, b.size(), "attribute name");
     if (name.empty()) return;
-    (void)zero_terminated("attribute type");
+    const std::string_view type = zero_terminated(at, b.size(), "attribute type");
     if (b.size() - at < 4) throw_at_offset(file, std::int64_t(at), "OpenEXR header", "ends inside an attribute");
     const std::uint32_t size = u32(at);
+    const std::string what = "attribute \"" + std::string(name) + "\" (" + std::string(type) + ")";
     if (size > b.size() - at - 4)
       throw_at_offset(file, std::int64_t(at), "OpenEXR header",
-                      "attribute \"" + std::string(name) + "\" declares " + std::to_string(size) + " bytes, " +
-                          std::to_string(b.size() - at - 4) + " follow");
-    at += 4 + size;
+                      what + " declares " + std::to_string(size) + " bytes, " + std::to_string(b.size() - at - 4) + " follow");
+    const std::size_t value = at + 4, end = value + size;
+    auto inconsistent = [&](const std::string& why) {
+      throw_at_offset(file, std::int64_t(at), "OpenEXR header", what + " declares " + std::to_string(size) + " bytes, " + why);
+    };
+    for (const auto& [fixed, bytes] : kFixed)
+      if (type == fixed && size != bytes) inconsistent("its type has " + std::to_string(bytes));
+    if (type == "chlist") {  // channels: name, then type, pLinear, 3 reserved bytes, xSampling, ySampling
+      std::size_t pos = value;
+      for (;;) {
+        if (pos >= end) inconsistent("its channel list does not end within them");
+        if (b[pos] == '\0') {
+          ++pos;
+          break;
+        }
+        (void)zero_terminated(pos, end, "channel name");
+        if (end - pos < 16) inconsistent("a channel's description runs past them");
+        pos += 16;
+      }
+      if (pos != end) inconsistent("its channel list ends after " + std::to_string(pos - value));
+    } else if (type == "stringvector") {  // strings, each a 4-byte length and its bytes
+      std::size_t pos = value;
+      while (pos < end) {
+        if (end - pos < 4 || u32(pos) > end - pos - 4) inconsistent("its strings do not fill them");
+        pos += 4 + u32(pos);
+      }
+    } else if (type == "preview") {  // width, height, then width · height RGBA bytes
+      if (size < 8 || std::uint64_t(u32(value)) * u32(value + 4) * 4 != std::uint64_t(size) - 8)
+        inconsistent("not 8 plus 4 bytes per preview pixel");
+    } else if (type == "idmanifest") {
+      throw_at_offset(file, std::int64_t(at), "OpenEXR header", what + ": compressed ID manifests are not read");
+    }
+    at = end;
   }
 }
 
@@ -191,6 +234,7 @@ void ExrReader::read_rows(int y0, int y1, float* out) {
 }
 
 ExrLayout probe_exr(std::string_view bytes, const std::string& file) {
+  check_exr_header(bytes, file);
   try {
     MemoryIStream stream(bytes, file);
     Imf::InputFile input(stream);
