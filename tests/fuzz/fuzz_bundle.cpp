@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// libFuzzer target: any bytes as a bundle's manifest.json (in a scratch bundle folder), then what a renderer
-// and `lumx check` do next: the reader's checks, every level and the volume loaded, the full check; and the
-// same bytes as an OpenEXR payload of a few shapes, decoded with the bundle's own reader. Only lumx::Error
-// may come out.
+// libFuzzer target: any bytes as a bundle's manifest.json (in a scratch bundle folder that also holds the
+// seed bundle's payload, levels/level00_n00001_r0008.exr, so that a manifest naming it with its digest gets
+// past the reader's checks to the payload), then what a renderer and `lumx check` do next: the reader's
+// checks, every level and the volume loaded, the full check; and the same bytes as an OpenEXR payload of a
+// few shapes, decoded with the bundle's own reader. Only lumx::Error may come out.
 //
 //   bash scripts/fuzz.sh bundle 300
 #include <lumx/io/bundle_io.h>
@@ -23,8 +24,14 @@
 namespace {
 
 const std::string& scratch_bundle() {
-  static const std::string dir = "/tmp/lumx_fuzz_bundle_" + std::to_string(::getpid());
-  std::filesystem::create_directories(dir);
+  static const std::string dir = [] {
+    const std::string d = "/tmp/lumx_fuzz_bundle_" + std::to_string(::getpid());
+    std::filesystem::create_directories(d + "/levels");
+    std::error_code ec;  // without the seed payload, manifests stop at the missing file (still a valid run)
+    std::filesystem::copy_file(LUMX_FUZZ_BUNDLE_PAYLOAD, d + "/levels/level00_n00001_r0008.exr",
+                               std::filesystem::copy_options::overwrite_existing, ec);
+    return d;
+  }();
   return dir;
 }
 
