@@ -349,6 +349,29 @@ TEST(Robustness, ExrHeadersOpenExrWouldReadElsewhereAreRefused) {
       EXPECT_NE(std::string(e.what()).find("its type has 16"), std::string::npos) << e.what();
     }
   }
+  // A data window of 16 × 2²⁴, 2²⁰ × 2²⁰ or 2³¹ × 2³¹ pixels in a 400-byte payload (hard-cases.md §6 item
+  // 27): refused, by the bundle's expected shape or by OpenEXR's own checks of the line offsets against the
+  // file, in under a second and 64 MiB, by decode_exr and by read_exr_image.
+  const std::size_t window = good.find(std::string("dataWindow\0box2i\0", 17)) + 17 + 4;
+  const fs::path dw = fresh_dir("exr_window");
+  for (const auto& [x_max, y_max] : {std::pair<std::int32_t, std::int32_t>{15, (1 << 24) - 1},
+                                     {(1 << 20) - 1, (1 << 20) - 1}, {0x7fffffff, 0x7fffffff}}) {
+    std::string bad = good;
+    for (int k = 0; k < 4; ++k) {
+      bad[window + 8 + k] = char(std::uint32_t(x_max) >> (8 * k));
+      bad[window + 12 + k] = char(std::uint32_t(y_max) >> (8 * k));
+    }
+    r = run_bounded([&] { (void)detail::decode_exr(bad, "w.exr", 16, 8, {"Y"}); });
+    EXPECT_TRUE(r.threw) << x_max << " " << y_max;
+    EXPECT_LT(r.seconds, 1.0 * kSlow);
+    EXPECT_LT(r.grown_kb, 64 * 1024 + kSanitizerKb) << x_max << " " << y_max;
+    std::ofstream(dw / "w.exr", std::ios::binary | std::ios::trunc) << bad;
+    r = run_bounded([&] { (void)read_exr_image((dw / "w.exr").string()); });
+    EXPECT_TRUE(r.threw) << x_max << " " << y_max;
+    EXPECT_LT(r.seconds, 1.0 * kSlow);
+    EXPECT_LT(r.grown_kb, 64 * 1024 + kSanitizerKb) << x_max << " " << y_max;
+  }
+  fs::remove_all(dw);
   // The same checks guard read_exr_image (any EXR, not only a bundle's): the 2 GiB attribute is refused.
   const fs::path d = fresh_dir("exr_image");
   const fs::path huge = d / "huge_attribute.exr";
