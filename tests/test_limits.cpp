@@ -349,6 +349,21 @@ TEST(Robustness, ExrHeadersOpenExrWouldReadElsewhereAreRefused) {
       EXPECT_NE(std::string(e.what()).find("its type has 16"), std::string::npos) << e.what();
     }
   }
+  // A float vector whose size is not a multiple of 4 (OpenEXR would read 4 of 5 bytes and go on one byte
+  // early): an attribute inserted before the end of a lumx payload's header.
+  {
+    const std::size_t header_end = good.find(std::string("screenWindowWidth\0float\0\4\0\0\0", 28)) + 28 + 4;
+    ASSERT_GT(header_end, 32u);
+    std::string bad = good.substr(0, header_end) + std::string("extra\0floatvector\0\5\0\0\0", 22) +
+                      std::string(5, '\0') + good.substr(header_end);
+    try {
+      (void)detail::decode_exr(bad, "v.exr", 16, 8, {"Y"});
+      ADD_FAILURE() << "a float vector of 5 bytes was read";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("floatvector"), std::string::npos) << e.what();
+      EXPECT_EQ(e.diagnostic().byte_offset, std::int64_t(header_end + 18)) << e.what();  // its size field
+    }
+  }
   // A data window of 16 × 2²⁴, 2²⁰ × 2²⁰ or 2³¹ × 2³¹ pixels in a 400-byte payload (hard-cases.md §6 item
   // 27): refused, by the bundle's expected shape or by OpenEXR's own checks of the line offsets against the
   // file, in under a second and 64 MiB, by decode_exr and by read_exr_image.

@@ -222,6 +222,7 @@ TEST(SphereMapTransform, DirectionRoundTripAtPolesEquatorCornersAndAxisPlanes) {
   for (const glm::vec3& w : dirs) {
     if (maps_onto_the_shared_edge(w)) continue;  // LowerSquaresLeftEdgeRoundTrips
     const glm::vec3 back = sphere_map::uv_to_direction(sphere_map::direction_to_uv(w));
+    EXPECT_NEAR(glm::length(glm::dvec3(back)), 1.0, 1e-6);  // uv_to_direction returns unit vectors
     const glm::dvec3 a = glm::normalize(glm::dvec3(w)), b = glm::normalize(glm::dvec3(back));
     const double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
     worst = std::max(worst, angle);

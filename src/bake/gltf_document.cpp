@@ -337,9 +337,9 @@ Document::Document(const std::string& path, const GltfReadOptions& options)
     throw_at_offset(path, json_offset + std::int64_t(e.byte > 0 ? e.byte - 1 : 0), "JSON", msg);
   } catch (const Json::exception& e) {  // a number beyond double's range (out_of_range 406) has no position
     const std::string_view text(reinterpret_cast<const char*>(json_begin), json_size);
-    const std::size_t at = lumx::detail::json_overflow_at(text, e.what());
-    throw_at_offset(path, at == std::string_view::npos ? -1 : json_offset + std::int64_t(at), "JSON",
-                    "a number beyond the range of a double");
+    const std::size_t at = e.id == 406 ? lumx::detail::json_overflow_at(text, e.what()) : std::string_view::npos;
+    if (at == std::string_view::npos) throw_at_field(path, "JSON", e.what());
+    throw_at_offset(path, json_offset + std::int64_t(at), "JSON", "a number beyond the range of a double");
   }
   if (!members.repeated().empty()) fail(members.repeated(), "this name appears twice in its object; readers disagree on which value counts");
   if (!json_.is_object()) throw_at_field(path, "", "the glTF JSON must be an object");
@@ -393,7 +393,11 @@ std::filesystem::path Document::resolve_uri(const std::string& uri, const std::s
   const fs::path inside = real_file.lexically_relative(real_folder);
   if (ec_folder || ec_file || inside.empty() || *inside.begin() == "..")
     fail(pointer, "'" + uri + "' leads out of the glTF file's folder" + option);
-  return folder / p;
+  for (const char c : decoded)
+    if (static_cast<unsigned char>(c) < 0x20) fail(pointer, "'" + uri + "' holds a control character");
+  // The resolved path, so that a later open (ray files are opened again when the tracer is built) reaches
+  // the file that was checked, whatever the working folder is then.
+  return real_file;
 }
 
 std::vector<std::uint8_t> Document::uri_bytes(const std::string& uri, const std::string& pointer,

@@ -21,8 +21,8 @@ LUMX_NAMESPACE_BEGIN
 namespace bake::detail {
 
 /// Where rays start, for a luminaire whose box is [lo, hi]. Embree intersects in float, so vertices and ray
-/// origins are given to it relative to the box centre (`to_embree`): a luminaire 10⁵ m from the origin is
-/// resolved as finely as one at it. A new ray starts ε off the surface it leaves: 10⁻⁵ of the diagonal (5 µm
+/// origins are given to it relative to the box centre (`to_embree`): tracing adds no loss of precision for
+/// a luminaire far from the origin (its vertices keep their own float precision). A new ray starts ε off the surface it leaves: 10⁻⁵ of the diagonal (5 µm
 /// for a 0.5 m luminaire), far above float rounding of the vertices, far below any modelled wall.
 struct RayStarts {
   glm::dvec3 centre{0.0};

@@ -96,15 +96,16 @@ void write_file_atomically(const std::string& path, std::string_view bytes) {
     ::unlink(tmp.c_str());
     fail(path, "rename", err);
   }
-  // Make the rename itself durable.
+  // Make the rename itself durable. A failure from here on is reported, but the new version is in place.
   const std::filesystem::path target(path);
   const std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  const char* in_place = "the new version is in place, but its folder could not be synced: ";
   const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd < 0) fail(path, "open folder for fsync", errno);
+  if (dfd < 0) fail(path, std::string(in_place) + "open folder for fsync", errno);
   if (::fsync(dfd) != 0 && errno != EINVAL) {  // EINVAL: the file system cannot sync folders
     const int err = errno;
     ::close(dfd);
-    fail(path, "fsync folder", err);
+    fail(path, std::string(in_place) + "fsync folder", err);
   }
   ::close(dfd);
 }

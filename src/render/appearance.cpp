@@ -252,9 +252,10 @@ struct AppearanceRenderer::Impl {
 
   /// Direct light at a non-specular vertex (p, geometric normal ng facing wo, shading frame) from one surface
   /// sample and every punctual emitter, weighted by f |wi·ns| and the medium's transmittance.
-  Rgb direct_light(const glm::dvec3& p, const glm::dvec3& ng, const Frame& frame, const glm::dvec3& wo_local,
-                   const Bsdf& bsdf, const Rgb& sigma_same, const Rgb& sigma_across, Pcg32& rng,
-                   PathCounters& counters) const {
+  /// Next-event estimation at p, reached along d_in after t metres (for where the shadow ray starts).
+  Rgb direct_light(const glm::dvec3& p, const glm::dvec3& ng, const glm::dvec3& d_in, double t_in, const Frame& frame,
+                   const glm::dvec3& wo_local, const Bsdf& bsdf, const Rgb& sigma_same, const Rgb& sigma_across,
+                   Pcg32& rng, PathCounters& counters) const {
     Rgb sum{0.0};
     glm::dvec3 wi_side{0.0};  // set by connect(): the light's direction, to choose the medium
     auto transmittance = [&](double distance) {
@@ -273,9 +274,13 @@ struct AppearanceRenderer::Impl {
       wi_side = wi_local;
       // The geometric and shading sides must agree (no light through the surface by its shading normal).
       if ((glm::dot(wi, ng) > 0.0) != (wi_local.z > 0.0)) return false;
-      const glm::dvec3 origin = starts.off_surface(p, ng, wi);
+      // As a path's next ray: a shadow ray on the side the path arrived from steps back along its segment,
+      // so that at a concave edge it cannot start in the plane of the other face and pass through it.
+      const glm::dvec3 origin = starts.after_hit(p, ng, d_in, t_in, wi);
+      const glm::dvec3 to_target = target - origin;
+      const double reach = glm::length(to_target);
       counters.rays += 1;
-      return !occluded(origin, wi, distance * (1.0 - 1e-4) - starts.scale);
+      return !(reach > 0.0) || !occluded(origin, to_target / reach, reach * (1.0 - 1e-4) - starts.scale);
     };
 
     const double u_light = rng.next_double(), u1 = rng.next_double(), u2 = rng.next_double();
@@ -416,7 +421,7 @@ struct AppearanceRenderer::Impl {
             across.remove(part_index);
           sigma_across = across.empty() ? Rgb{0.0} : absorption[scene.parts[across.top()].material];
         }
-        sum += beta * direct_light(position, ng, frame, wo_local, bsdf, sigma, sigma_across, rng, counters);
+        sum += beta * direct_light(position, ng, direction, t, frame, wo_local, bsdf, sigma, sigma_across, rng, counters);
       }
 
       const double u_lobe = rng.next_double();

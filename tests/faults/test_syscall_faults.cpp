@@ -182,6 +182,11 @@ TEST(SyscallFaults, Tm25WritesFailingAnywhereKeepTheOldFile) {
     MemoryRaySource source(std::move(rays), info);
     write_tm25(target.string(), info, source);
   };
+  {  // the header is completed with pwrite: the interposition must see it, or part of the writer is untested
+    Armed watch(Fault{});
+    write_rays(3e-3f);
+    EXPECT_GT(lumx_faults::bytes_pwritten(), 0u);
+  }
   expect_failed_writes_keep_the_old_file(target, [&] { write_rays(1e-3f); }, [&] { write_rays(2e-3f); }, 37);
   fs::remove_all(d);
 }
@@ -231,7 +236,8 @@ AplSet small_set(float scale) {
 }  // namespace
 
 // A bundle is a folder of payloads and a manifest, written into a scratch folder and swapped in: a failure
-// anywhere leaves the previous bundle whole and readable, and no scratch folder.
+// before the swap leaves the previous bundle whole and readable, one after it (the parent folder's sync)
+// the new one, and neither leaves a scratch folder.
 TEST(SyscallFaults, BundleWritesFailingAnywhereKeepThePreviousBundle) {
   const fs::path d = fresh_dir("bundle");
   const fs::path target = d / "lamp.lumx";
@@ -258,9 +264,42 @@ TEST(SyscallFaults, BundleWritesFailingAnywhereKeepThePreviousBundle) {
   expect_intact(failure_of({Call::write, EIO, total - 1}, write_new), std::strerror(EIO), "EIO at the last byte");
   expect_intact(failure_of({Call::fsync_file, EIO}, write_new), "fsync", "fsync of a payload");
   expect_intact(failure_of({Call::close_file, EIO}, write_new), "close", "close of a payload");
-  // A folder that cannot be synced (other than EINVAL: file systems that cannot sync folders) is an error
-  // too; the first one is inside the scratch folder, before anything was replaced.
-  expect_intact(failure_of({Call::fsync_directory, EIO}, write_new), "fsync folder", "fsync of a folder");
+  // Each folder sync in turn (the payloads' folder after each payload, the scratch bundle's folders, the
+  // parent after the swap) failing with EIO (EINVAL, a file system that cannot sync folders, is accepted):
+  // an error naming the bundle, and either the previous bundle or, once swapped in, the new one, whole.
+  int syncs = 0;
+  {
+    Armed count_them(Fault{});
+    write_new();
+    syncs = lumx_faults::directory_syncs();
+  }
+  write_bundle(target.string(), a);
+  ASSERT_GE(syncs, 4);
+  const std::string new_manifest = [&] {
+    const fs::path other = d / "other";
+    fs::create_directories(other);
+    write_bundle((other / "lamp.lumx").string(), b);
+    const std::string m = slurp(other / "lamp.lumx" / "manifest.json");
+    fs::remove_all(other);
+    return m;
+  }();
+  for (int k = 1; k <= syncs; ++k) {
+    Fault f{Call::fsync_directory, EIO};
+    f.nth = k;
+    const std::string what = failure_of(f, write_new);
+    const std::string why = "folder sync " + std::to_string(k) + " of " + std::to_string(syncs);
+    EXPECT_NE(what.find(target.string()), std::string::npos) << why << ": " << what;
+    EXPECT_NE(what.find("fsync folder"), std::string::npos) << why << ": " << what;
+    const std::string now = slurp(target / "manifest.json");
+    EXPECT_TRUE(now == old_manifest || now == new_manifest) << why;
+    EXPECT_TRUE(check_bundle(target.string()).empty()) << why;
+    EXPECT_TRUE(leftovers(d, target).empty()) << why;
+    if (k == syncs) {  // the last is the parent's, after the swap: the new bundle is in place
+      EXPECT_EQ(now, new_manifest) << why;
+      EXPECT_NE(what.find("new version is in place"), std::string::npos) << why << ": " << what;
+    }
+    write_bundle(target.string(), a);
+  }
   // Errors name the payload inside the bundle that was asked for, not the scratch folder.
   const std::string what = failure_of({Call::write, ENOSPC, 0}, write_new);
   EXPECT_EQ(what.rfind(target.string() + "/levels/level00_", 0), 0u) << what;
@@ -279,6 +318,7 @@ TEST(SyscallFaults, FailedFolderSyncReportsAndLeavesTheWholeNewFile) {
   write_photometry(table(1), target.string());
   const std::string what = failure_of({Call::fsync_directory, EIO}, [&] { write_photometry(table(2), target.string()); });
   EXPECT_NE(what.find("fsync folder"), std::string::npos) << what;
+  EXPECT_NE(what.find("the new version is in place"), std::string::npos) << what;
   EXPECT_NE(what.find(target.string()), std::string::npos) << what;
   write_photometry(table(2), (d / "fresh.ies").string());
   EXPECT_EQ(slurp(target), slurp(d / "fresh.ies"));

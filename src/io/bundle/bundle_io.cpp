@@ -87,7 +87,7 @@ void write_scratch_file(const std::string& folder, const std::string& relative, 
   try {
     write_file_atomically(join(folder, relative), bytes);
   } catch (const Error& e) {
-    fail(bundle + "/" + relative, e.diagnostic().field, e.diagnostic().message);
+    fail(bundle + "/" + relative, e.diagnostic().field, "while writing the new bundle: " + e.diagnostic().message);
   }
 }
 
@@ -292,7 +292,11 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
       fail(path, "rename", std::string("cannot move the new bundle in place: ") + std::strerror(errno));
     }
     // After the swap the new bundle is in place: a failure here is reported, and leaves it whole.
-    fsync_folder(target.parent_path().string(), path);
+    try {
+      fsync_folder(target.parent_path().string(), path);
+    } catch (const Error& e) {
+      fail(path, "file", "the new version is in place, but its folder could not be synced: " + e.diagnostic().message);
+    }
   } catch (const Error&) {
     fs::remove_all(tmp, ec);
     throw;

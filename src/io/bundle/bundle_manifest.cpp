@@ -223,7 +223,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     d.message = e.what();
     throw Error(std::move(d));
   } catch (const json::exception& e) {  // a number beyond double's range (out_of_range 406): no position given
-    const std::size_t at = detail::json_overflow_at(text, e.what());
+    const std::size_t at = e.id == 406 ? detail::json_overflow_at(text, e.what()) : std::string_view::npos;
     if (at == std::string_view::npos) r.fail("", std::string("not valid JSON for a manifest: ") + e.what());
     Diagnostic d;
     d.file = file;

@@ -70,8 +70,8 @@ class MemoryIStream : public Imf::IStream {
 /// their content: a fixed-size type declared with another size, or a channel list that does not end where
 /// its size says, leaves OpenEXR reading the next attribute at another offset than the header's, where any
 /// bytes become a size (found by fuzz_bundle: 1.9 GB for a 465-byte payload). So: every size must fit in
-/// the bytes that follow; fixed-size types must have their size; a channel list, a string vector and a
-/// preview image must fill their declared size exactly; ID manifests (compressed) are refused. Single-part
+/// the bytes that follow; fixed-size types must have their size; a channel list, a string vector, a float
+/// vector and a preview image must fill their declared size exactly; ID manifests (compressed) are refused. Single-part
 /// scanline images only. Unknown types are read by OpenEXR as opaque bytes of the declared size.
 void check_exr_header(std::string_view b, const std::string& file) {
   const auto u32 = [&](std::size_t at) {
@@ -136,6 +136,8 @@ void check_exr_header(std::string_view b, const std::string& file) {
     } else if (type == "preview") {  // width, height, then width · height RGBA bytes
       if (size < 8 || std::uint64_t(u32(value)) * u32(value + 4) * 4 != std::uint64_t(size) - 8)
         inconsistent("not 8 plus 4 bytes per preview pixel");
+    } else if (type == "floatvector") {  // OpenEXR reads size / 4 floats: a remainder would be left unread
+      if (size % 4 != 0) inconsistent("not a whole number of 4-byte floats");
     } else if (type == "idmanifest") {
       throw_at_offset(file, std::int64_t(at), "OpenEXR header", what + ": compressed ID manifests are not read");
     }

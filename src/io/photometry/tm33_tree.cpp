@@ -291,7 +291,7 @@ Tm33Node parse_tm33_json_tree(std::string_view text, const std::string& file) {
     if (colon != std::string::npos) msg = msg.substr(colon);
     throw_at_line(file, line, "JSON", msg);
   } catch (const ojson::exception& e) {  // a number too large for a double: nlohmann gives no position
-    const std::size_t at = detail::json_overflow_at(text, e.what());
+    const std::size_t at = e.id == 406 ? detail::json_overflow_at(text, e.what()) : std::string_view::npos;
     if (at == std::string_view::npos) throw_at_field(file, "JSON", e.what());
     throw_at_line(file, 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n')), "JSON",
                   "a number beyond the range of a double");
