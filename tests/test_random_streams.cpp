@@ -148,10 +148,8 @@ TEST(RandomStreams, TheStatisticsRejectFlawedStreams) {
     }
     std::uint32_t next() {
       const std::uint64_t old = state;
-      state = old * 6364136223846793005ULL + inc;
-      const auto x = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
-      const auto rot = static_cast<std::uint32_t>(old >> 59u);
-      return (x >> rot) | (x << ((32u - rot) & 31u));
+      state = old * Pcg32::kMultiplier + inc;
+      return Pcg32::output(old);
     }
   };
   const Draws unmixed = first_draws([](std::uint64_t stream) {

@@ -16,10 +16,10 @@ namespace detail {
 /// Nesting depth no lumx reader accepts beyond (hard-cases.md §6 item 30).
 constexpr std::size_t kMaxJsonDepth = 256;
 
-/// Byte offset of the first '[' or '{' (outside strings) that opens nesting level `max_depth + 1`, or
-/// std::string_view::npos if the text never nests that deep. Linear, no allocation.
-inline std::size_t json_too_deep_at(std::string_view text, std::size_t max_depth = kMaxJsonDepth) {
-  std::size_t depth = 0;
+/// Calls visit(i, c) for every byte of `text` outside JSON strings (and their escapes), in order, until it
+/// returns true; the offset where it did, or npos.
+template <class Visit>
+std::size_t find_outside_strings(std::string_view text, Visit visit) {
   bool in_string = false;
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
@@ -28,33 +28,32 @@ inline std::size_t json_too_deep_at(std::string_view text, std::size_t max_depth
       else if (c == '"') in_string = false;
     } else if (c == '"') {
       in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > max_depth) return i;
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
+    } else if (visit(i, c)) {
+      return i;
     }
   }
   return std::string_view::npos;
 }
 
+/// Byte offset of the first '[' or '{' (outside strings) that opens nesting level `max_depth + 1`, or
+/// std::string_view::npos if the text never nests that deep. Linear, no allocation.
+inline std::size_t json_too_deep_at(std::string_view text, std::size_t max_depth = kMaxJsonDepth) {
+  std::size_t depth = 0;
+  return find_outside_strings(text, [&](std::size_t, char c) {
+    if (c == '[' || c == '{') return ++depth > max_depth;
+    if ((c == ']' || c == '}') && depth > 0) --depth;
+    return false;
+  });
+}
+
 /// Byte offset of the first number token equal to `token` outside strings, or npos. nlohmann/json reports a
 /// number beyond double's range (out_of_range 406) without its position; this finds it again.
 inline std::size_t json_number_at(std::string_view text, std::string_view token) {
-  auto part_of_number = [](char c) { return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.' || c == 'e' || c == 'E'; };
-  bool in_string = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      if (c == '\\') ++i;
-      else if (c == '"') in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (text.compare(i, token.size(), token) == 0 && (i == 0 || !part_of_number(text[i - 1])) &&
-               (i + token.size() == text.size() || !part_of_number(text[i + token.size()]))) {
-      return i;
-    }
-  }
-  return std::string_view::npos;
+  const auto part_of_number = [](char c) { return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.' || c == 'e' || c == 'E'; };
+  return find_outside_strings(text, [&](std::size_t i, char) {
+    return text.compare(i, token.size(), token) == 0 && (i == 0 || !part_of_number(text[i - 1])) &&
+           (i + token.size() == text.size() || !part_of_number(text[i + token.size()]));
+  });
 }
 
 /// The position-free exception's number, quoted in its message ("... parsing '1e400'"), found in `text`.

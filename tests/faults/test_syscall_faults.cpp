@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "syscall_faults.h"
+#include "test_support.h"
 
 #include <cerrno>
 #include <cmath>
@@ -35,19 +36,9 @@ using lumx_faults::Fault;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("lumx_faults_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path fresh_dir(const std::string& name) { return lumx_test::fresh_temp_dir("lumx_faults_" + name); }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string slurp(const fs::path& p) { return lumx_test::read_text(p); }
 
 /// Everything in `folder` except `keep`: temporaries (".NAME.tmp-PID-N") and scratch bundles.
 std::vector<std::string> leftovers(const fs::path& folder, const fs::path& keep) {

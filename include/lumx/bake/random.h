@@ -39,9 +39,16 @@ class Pcg32 {
 
   std::uint32_t next_u32() {
     const std::uint64_t old = state_;
-    state_ = old * 6364136223846793005ULL + inc_;
-    const auto xorshifted = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
-    const auto rot = static_cast<std::uint32_t>(old >> 59u);
+    state_ = old * kMultiplier + inc_;
+    return output(old);
+  }
+
+  /// The 64-bit LCG's multiplier (Knuth's MMIX constant, as PCG uses).
+  static constexpr std::uint64_t kMultiplier = 6364136223846793005ULL;
+  /// PCG's XSH-RR output permutation of a state (O'Neill 2014 §6.3.1): xorshift high, random rotation.
+  static std::uint32_t output(std::uint64_t state) {
+    const auto xorshifted = static_cast<std::uint32_t>(((state >> 18u) ^ state) >> 27u);
+    const auto rot = static_cast<std::uint32_t>(state >> 59u);
     return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
   }
 
