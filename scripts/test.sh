@@ -10,8 +10,9 @@ skip=()
 if [ "${1:-}" = "--sanitize" ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   export LSAN_OPTIONS="suppressions=$(pwd)/scripts/lsan.supp"
-  # Accuracy checks that only repeat, at ten times the cost under the sanitizers, code paths the smaller
-  # tests of the same modules already run there; the release run (the README's command) keeps them.
-  skip=(-E '^(AplErrorMeasured\.(RealTm25FilesMeetTheNoiseFloor|OsramBlueLedMeetsTheNoiseFloor)|SphericalKernelDensityAccuracy\..*|BakeExactIrradiance\..*|AplFarField\.RealPhotometryRoundTripsThroughAnApl)$')
+  # Accuracy checks and a real-file sweep that only repeat, at ten times the cost under the sanitizers,
+  # code paths the smaller tests of the same modules already run there; the release run (the README's
+  # command) keeps them.
+  skip=(-E '^(AplErrorMeasured\.(RealTm25FilesMeetTheNoiseFloor|OsramBlueLedMeetsTheNoiseFloor)|SphericalKernelDensityAccuracy\..*|BakeExactIrradiance\..*|AplFarField\.RealPhotometryRoundTripsThroughAnApl|Tm33\.EveryRealIesAndLdtFileRoundTrips)$')
 fi
 ctest --test-dir "$dir" --output-on-failure -j "$(nproc)" "${skip[@]}"

@@ -36,6 +36,21 @@ inline std::filesystem::path fresh_temp_dir(const std::string& name) {
   return p;
 }
 
+/// In the sanitizer build (about ten times slower), every `stride`-th item of a sweep over real files, and
+/// how many the release build's bound on the count should be divided by; elsewhere everything, and 1.
+/// Sweeps keep every file in the release run; under the sanitizers a subset runs the same code paths.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr std::size_t kSanitizerStride = 4;
+#else
+constexpr std::size_t kSanitizerStride = 1;
+#endif
+template <class T>
+std::vector<T> sanitizer_subset(const std::vector<T>& all) {
+  std::vector<T> out;
+  for (std::size_t i = 0; i < all.size(); i += kSanitizerStride) out.push_back(all[i]);
+  return out;
+}
+
 /// tests/data in the source tree: only files lumx made itself (bad-input corpus, synthetic fixtures).
 inline std::filesystem::path data_dir() { return LUMX_TEST_DATA_DIR; }
 
