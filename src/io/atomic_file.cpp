@@ -96,18 +96,21 @@ void write_file_atomically(const std::string& path, std::string_view bytes) {
     ::unlink(tmp.c_str());
     fail(path, "rename", err);
   }
-  // Make the rename itself durable. A failure from here on is reported, but the new version is in place.
+  // Make the rename itself durable.
   const std::filesystem::path target(path);
-  const std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-  const char* in_place = "the new version is in place, but its folder could not be synced: ";
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd < 0) fail(path, std::string(in_place) + "open folder for fsync", errno);
-  if (::fsync(dfd) != 0 && errno != EINVAL) {  // EINVAL: the file system cannot sync folders
+  sync_folder(target.has_parent_path() ? target.parent_path().string() : std::string("."), path, true);
+}
+
+void sync_folder(const std::string& folder, const std::string& reported_path, bool replaced) {
+  const std::string prefix = replaced ? "the new version is in place, but its folder could not be synced: " : "";
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) fail(reported_path, prefix + "open folder for fsync", errno);
+  if (::fsync(fd) != 0 && errno != EINVAL) {  // EINVAL: the file system cannot sync folders
     const int err = errno;
-    ::close(dfd);
-    fail(path, std::string(in_place) + "fsync folder", err);
+    ::close(fd);
+    fail(reported_path, prefix + "fsync folder", err);
   }
-  ::close(dfd);
+  ::close(fd);
 }
 
 std::string read_file_bounded(const std::string& path, std::size_t max_bytes, const std::string& limit_name) {

@@ -27,6 +27,11 @@ void remove_stale_temporaries(const std::string& target);
 /// Replaces `path` with `bytes`. Throws lumx::Error naming the path and the failing step.
 void write_file_atomically(const std::string& path, std::string_view bytes);
 
+/// Makes `folder`'s entries (a rename into it) durable. A file system that cannot sync folders (EINVAL) is
+/// not an error; any other failure throws lumx::Error located at `reported_path`, the path the caller was
+/// asked to write. `replaced`: the new version is already in place, and the message says so.
+void sync_folder(const std::string& folder, const std::string& reported_path, bool replaced);
+
 /// Reads a whole file, refusing files larger than `max_bytes`; the error names `limit_name` (the option that
 /// set the bound, e.g. "ReadLimits::max_file_bytes") when given. Throws lumx::Error.
 std::string read_file_bounded(const std::string& path, std::size_t max_bytes, const std::string& limit_name = {});

@@ -103,18 +103,6 @@ BundlePayload write_payload(const std::string& folder, const std::string& relati
   return p;
 }
 
-/// Makes the folder's entries durable. A file system that cannot sync folders (EINVAL) is not an error;
-/// any other failure is, located at `bundle` (the path the caller asked for).
-void fsync_folder(const std::string& folder, const std::string& bundle) {
-  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) fail(bundle, "file", std::string("open folder for fsync: ") + std::strerror(errno));
-  if (::fsync(fd) != 0 && errno != EINVAL) {
-    const int err = errno;
-    ::close(fd);
-    fail(bundle, "file", std::string("fsync folder: ") + std::strerror(err));
-  }
-  ::close(fd);
-}
 
 std::string temporary_sibling(const fs::path& target) { return temporary_sibling_name(target.string()); }
 
@@ -282,8 +270,8 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
     const std::string manifest_text = detail::manifest_to_json(m);
     detail::parse_manifest(manifest_text, path + "/" + bundle::kManifestName, BundleLimits{});
     write_scratch_file(tmp, bundle::kManifestName, manifest_text, path);
-    fsync_folder(tmp + "/levels", path);
-    fsync_folder(tmp, path);
+    sync_folder(tmp + "/levels", path, false);
+    sync_folder(tmp, path, false);
 
     if (exists) {
       swap_in(tmp, target, path);  // the old bundle is now at tmp
@@ -292,11 +280,7 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
       fail(path, "rename", std::string("cannot move the new bundle in place: ") + std::strerror(errno));
     }
     // After the swap the new bundle is in place: a failure here is reported, and leaves it whole.
-    try {
-      fsync_folder(target.parent_path().string(), path);
-    } catch (const Error& e) {
-      fail(path, "file", "the new version is in place, but its folder could not be synced: " + e.diagnostic().message);
-    }
+    sync_folder(target.parent_path().string(), path, true);
   } catch (const Error&) {
     fs::remove_all(tmp, ec);
     throw;

@@ -532,19 +532,8 @@ void AtomicStreamFile::commit() {
     ::unlink(tmp_.c_str());
     throw_at_field(path_, "file", std::string("rename: ") + std::strerror(err));
   }
-  namespace fs = std::filesystem;
-  const fs::path target(path_);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  // A failure from here on is reported, but the new version is in place.
-  const std::string in_place = "the new version is in place, but its folder could not be synced: ";
-  if (dfd < 0) throw_at_field(path_, "file", in_place + "open folder for fsync: " + std::strerror(errno));
-  if (::fsync(dfd) != 0 && errno != EINVAL) {
-    const int err = errno;
-    ::close(dfd);
-    throw_at_field(path_, "file", in_place + "fsync folder: " + std::strerror(err));
-  }
-  ::close(dfd);
+  const std::filesystem::path target(path_);
+  sync_folder(target.has_parent_path() ? target.parent_path().string() : std::string("."), path_, true);
 }
 
 }  // namespace detail
