@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <memory>
 #include <string>
@@ -160,6 +161,8 @@ TEST(RandomStreams, TheStatisticsRejectFlawedStreams) {
     };
   });
   const Verdict bad_pcg = judge(unmixed);
+  std::printf("unmixed LCG: worst |z| %.1f (%s); PCG32 with increment 2i + 1: worst |z| %.1f (%s)\n",
+              std::abs(bad_lcg.worst_z), bad_lcg.worst.c_str(), std::abs(bad_pcg.worst_z), bad_pcg.worst.c_str());
   EXPECT_GT(std::abs(bad_pcg.worst_z), 20.0) << bad_pcg.worst;
   EXPECT_NE(bad_pcg.worst.find("stream +2^"), std::string::npos) << bad_pcg.worst;
 }
