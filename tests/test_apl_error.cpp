@@ -375,6 +375,35 @@ TEST(AplErrorLevels, LevelZeroFarAwayIsNearTheNoiseFloorWithTheBuilderRule) {
   EXPECT_LT(ra.levels[0].errors[0].relative_rmse, noise);
 }
 
+TEST(AplErrorSpheres, RotatedPatchCentresFallAtGenericPlacesOfTheMaps) {
+  // A bilinear lookup at a texel centre returns the texel's mean and hides the interpolation error a
+  // renderer's shading point sees. In the photometric frame every R 16 patch centre is an R 16 map's
+  // texel centre; in the rotated patch frame (the default) few are near any texel centre of any map.
+  BoundingSphere b;
+  AplErrorOptions o;
+  const auto near_texel_centres = [&](bool rotated, int R) {
+    o.rotated_patches = rotated;
+    const MeasurementSpheres ms(b, o);
+    std::size_t near = 0;
+    const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);
+    for (const glm::dvec3& d : dirs) {
+      int half;
+      const glm::vec2 q = sphere_map::direction_to_square(glm::vec3(d), half);
+      const double fx = double(q.x) * R - std::floor(double(q.x) * R), fy = double(q.y) * R - std::floor(double(q.y) * R);
+      if (std::abs(fx - 0.5) < 0.05 && std::abs(fy - 0.5) < 0.05) ++near;  // within 5 % of a texel of its centre
+    }
+    return double(near) / double(dirs.size());
+  };
+  EXPECT_GT(near_texel_centres(false, 16), 0.99);
+  for (int R : {8, 16, 32, 64}) EXPECT_LT(near_texel_centres(true, R), 0.05) << R;  // a uniform spread: ~1 %
+  // The frame is a rotation (orthonormal, determinant 1).
+  const glm::dmat3 Q = MeasurementSpheres::patch_frame();
+  const glm::dmat3 I = glm::transpose(Q) * Q;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(I[i][j], i == j ? 1.0 : 0.0, 1e-12);
+  EXPECT_NEAR(glm::determinant(Q), 1.0, 1e-12);
+}
+
 TEST(AplErrorLevels, RaysFromOnePointGiveNoiseForEveryLevel) {
   // Every ray from one point: the builder's bound has radius 0 (min_diameter is used) and its centre is
   // the point, so the spheres are centred on the source. Then E_ref ∝ 1/ρ² on every sphere, and so is
@@ -388,6 +417,9 @@ TEST(AplErrorLevels, RaysFromOnePointGiveNoiseForEveryLevel) {
   AplErrorOptions o;
   o.min_timing_seconds = 0;
   o.patch_subsamples = 1;
+  // Patches in the photometric frame: their centres are texel centres of the R 64 maps' 2×2 blocks, where
+  // the lookup is the texels' mean, so the level reproduces the patch sums and only the noise is measured.
+  o.rotated_patches = false;
   const AplErrorReport r = evaluate_apl_errors(set, rays, o);
   EXPECT_DOUBLE_EQ(r.reference.spheres.diameter(), 1e-3);
   const double noise = r.reference.sphere[0].noise_floor;
