@@ -86,15 +86,22 @@ void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lu
   }
   if (r.error_tables_stored && r.held_out.fitted) {
     std::printf("maps:     resolutions chosen on held-out rays:");
-    for (int res : r.resolution) std::printf(" %d", res);
+    for (std::size_t k = 0; k < r.resolution.size(); ++k) {
+      std::printf(" %d", r.resolution[k]);
+      const std::vector<double>& kappa = r.held_out.choice.kappa;
+      if (k < kappa.size() && kappa[k] > 0) std::printf(" (kernel σ %.1f°)", 180.0 / lumx::kPi / std::sqrt(kappa[k]));
+    }
     std::printf(" (levels 0..%zu)\n", r.resolution.size() - 1);
   }
   for (const std::string& note : r.notes) std::fprintf(stderr, "%s: note: %s\n", a.rays.c_str(), note.c_str());
   if (r.far_field_attached)
-    std::printf("far field: %.2f lm (%s; level 0's maps at R %d), attached as IES and EULUMDAT\n", r.far_field_lm,
+    std::printf("far field: %.2f lm (%s; level 0's maps at R %d%s), attached as IES and EULUMDAT\n", r.far_field_lm,
                 quantity == lumx::PhotometricQuantity::radiometric ? "rays in W, converted to lm"
                                                                                 : "rays in lm",
-                r.far_field_resolution);
+                r.far_field_resolution,
+                r.far_field_kernel_sigma_deg > 0
+                    ? (", kernel σ " + std::to_string(r.far_field_kernel_sigma_deg).substr(0, 4) + "°").c_str()
+                    : "");
   std::printf("bundle:   %s, %llu bytes; evaluation %.2f s, far field %.2f s, writing %.2f s; %.2f s in all\n",
               a.out.c_str(), (unsigned long long)r.bytes, r.seconds_evaluation, r.seconds_far_field, r.seconds_write,
               r.seconds_build + r.seconds_evaluation + r.seconds_far_field + r.seconds_write);

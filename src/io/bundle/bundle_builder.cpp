@@ -170,8 +170,9 @@ BundleBuildResult build_bundle(RaySource& rays, const std::string& out, const Bu
     far_set.channels = set.channels;
     far_set.provenance = set.provenance;
     const int fitted_r = result.held_out.choice.far_field_resolution;
+    const double fitted_kappa = result.held_out.choice.far_field_kappa;
     far_set.levels.push_back(fitted_r > 0 && fitted_r <= built_level0.map_resolution
-                                 ? downsampled_level(built_level0, fitted_r)
+                                 ? fitted_level(built_level0, fitted_r, fitted_kappa)
                                  : set.levels.at(0));
     const Photometry far = far_field_photometry(far_set, 0, grid);
     wo.attachments.push_back({"far_field.ies", "application/x-ies-lm63", format_ies(far)});
@@ -179,6 +180,8 @@ BundleBuildResult build_bundle(RaySource& rays, const std::string& out, const Bu
     result.far_field_attached = true;
     result.far_field_lm = IntensityTable(far).flux_lm();
     result.far_field_resolution = far_set.levels[0].map_resolution;
+    result.far_field_kernel_sigma_deg =
+        fitted_r > 0 && fitted_kappa > 0 ? 180.0 / kPi / std::sqrt(fitted_kappa) : 0.0;
   }
   const auto far_done = Clock::now();
   for (const auto& attachment : o.attachments) wo.attachments.push_back(attachment);

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// lumx/math/sphere_map_kernel.h — flux-exact smoothing of a sphere map by a von Mises–Fisher kernel.
+//
+// A map binned from m rays over T texels has a relative noise of about 1/√(m/T) per texel, and a
+// renderer's point query sees it. Convolving with the von Mises–Fisher kernel
+// K(ω, ω') ∝ exp(κ (ω·ω' − 1)) (the spherical Gaussian: σ ≈ 1/√κ rad along each tangent axis) averages
+// each texel with its neighbours within a few σ, for a bias of about Δf / (2κ) (Δ the Laplacian on the
+// sphere: for a Lambertian cos θ, −cos θ / κ, 0.25 % at κ = 400) — a kernel density estimate on the
+// sphere (seed 004 §4; algorithms.md §8) with the texels as its samples. How wide is measured, not
+// assumed: the held-out fit (apl/error.h) tries several κ per level and keeps what the held-out rays
+// grade best, so a sharp shadow border backed by many rays keeps a narrow kernel or none.
+//
+// Discretely, each source texel s hands its value to the texels t with weights
+// w_ts = exp(κ(ω_t·ω_s − 1)) / Σ_t' exp(κ(ω_t'·ω_s − 1)), truncated where the kernel is below 10⁻³ of
+// its peak (1 − ω_t·ω_s > ln(10³)/κ, 3.7 σ). The weights of each source sum to 1 and texels are equal-area, so
+// the map's flux is kept exactly (up to float rounding), whatever κ; a map with one lit texel becomes the
+// kernel. Directions are texel centres, so the kernel crosses the equator seam and the squares' diagonals
+// as the sphere does, not as the square's coordinates do.
+#pragma once
+
+#include <lumx/math/sphere_map.h>
+#include <lumx/version.h>
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+LUMX_NAMESPACE_BEGIN
+
+class SphereMapKernel {
+ public:
+  /// Largest resolution the kernel is built for: it finds neighbours by comparing every pair of texel
+  /// centres (2R² × 2R² dot products: 6.7·10⁷ at R 64, a few tenths of a second).
+  static constexpr int kMaxResolution = 64;
+
+  /// The kernel for maps of resolution R (1..kMaxResolution) and concentration κ > 0 (1/rad²).
+  SphereMapKernel(int resolution, double kappa) : resolution_(resolution), kappa_(kappa) {
+    if (resolution < 1 || resolution > kMaxResolution)
+      throw std::invalid_argument("SphereMapKernel: resolution " + std::to_string(resolution) + " outside [1, " +
+                                  std::to_string(kMaxResolution) + "]");
+    if (!(kappa > 0) || !std::isfinite(kappa))
+      throw std::invalid_argument("SphereMapKernel: kappa must be positive and finite");
+    const int W = 2 * resolution, T = W * resolution;
+    std::vector<glm::dvec3> centre(static_cast<std::size_t>(T));
+    for (int y = 0; y < resolution; ++y)
+      for (int x = 0; x < W; ++x)
+        centre[std::size_t(y) * std::size_t(W) + std::size_t(x)] = glm::normalize(glm::dvec3(sphere_map::uv_to_direction(
+            {(float(x) + 0.5f) / float(W), (float(y) + 0.5f) / float(resolution)})));
+    const double cut = std::log(1e3) / kappa;  // 1 − cos of the truncation angle
+    // Per source: its targets and normalised weights; then gathered per target (CSR), so that applying
+    // the kernel writes each output texel once.
+    std::vector<std::vector<std::pair<std::uint32_t, float>>> by_target(static_cast<std::size_t>(T));
+    std::vector<std::pair<std::uint32_t, double>> row;
+    for (int s = 0; s < T; ++s) {
+      row.clear();
+      double sum = 0;
+      for (int t = 0; t < T; ++t) {
+        const double one_minus_cos = 1.0 - glm::dot(centre[std::size_t(s)], centre[std::size_t(t)]);
+        if (one_minus_cos > cut) continue;
+        const double w = std::exp(-kappa * one_minus_cos);
+        row.push_back({std::uint32_t(t), w});
+        sum += w;
+      }
+      for (const auto& [t, w] : row) by_target[t].push_back({std::uint32_t(s), float(w / sum)});
+    }
+    offsets_.assign(std::size_t(T) + 1, 0);
+    for (int t = 0; t < T; ++t) offsets_[std::size_t(t) + 1] = offsets_[std::size_t(t)] + std::uint32_t(by_target[std::size_t(t)].size());
+    sources_.reserve(offsets_.back());
+    weights_.reserve(offsets_.back());
+    for (const auto& list : by_target)
+      for (const auto& [s, w] : list) sources_.push_back(s), weights_.push_back(w);
+  }
+
+  /// The kernel for (R, κ) from a small process-wide cache (the last 8 built; thread-safe): building one
+  /// costs more than applying it to a few hundred maps.
+  static std::shared_ptr<const SphereMapKernel> shared(int resolution, double kappa) {
+    static std::mutex mutex;
+    static std::vector<std::shared_ptr<const SphereMapKernel>> cache;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      for (const auto& k : cache)
+        if (k->resolution() == resolution && k->kappa() == kappa) return k;
+    }
+    auto k = std::make_shared<const SphereMapKernel>(resolution, kappa);
+    std::lock_guard<std::mutex> lock(mutex);
+    if (cache.size() >= 8) cache.erase(cache.begin());
+    cache.push_back(k);
+    return k;
+  }
+
+  int resolution() const { return resolution_; }
+  double kappa() const { return kappa_; }
+  /// The kernel's standard deviation along one tangent axis, 1/√κ (rad).
+  double sigma() const { return 1.0 / std::sqrt(kappa_); }
+  /// Non-zero weights in all (the cost of apply, per channel).
+  std::size_t weight_count() const { return weights_.size(); }
+
+  /// The smoothed map (same resolution and channels; flux kept). Throws for another resolution.
+  SphereMap apply(const SphereMap& in) const {
+    if (in.resolution() != resolution_)
+      throw std::invalid_argument("SphereMapKernel: a map of resolution " + std::to_string(in.resolution()) +
+                                  " for a kernel of " + std::to_string(resolution_));
+    const int C = in.channels();
+    SphereMap out(resolution_, C);
+    const float* src = in.data();
+    float* dst = out.data();
+    const std::size_t T = offsets_.size() - 1;
+    for (std::size_t t = 0; t < T; ++t)
+      for (int c = 0; c < C; ++c) {
+        double v = 0;
+        for (std::uint32_t i = offsets_[t]; i < offsets_[t + 1]; ++i)
+          v += double(weights_[i]) * double(src[std::size_t(sources_[i]) * std::size_t(C) + std::size_t(c)]);
+        dst[t * std::size_t(C) + std::size_t(c)] = float(v);
+      }
+    return out;
+  }
+
+ private:
+  int resolution_ = 0;
+  double kappa_ = 0;
+  std::vector<std::uint32_t> offsets_, sources_;
+  std::vector<float> weights_;
+};
+
+LUMX_NAMESPACE_END
