@@ -114,11 +114,11 @@ TEST(BakeExactIrradiance, LambertianDisk) {
   EXPECT_NEAR(exit_flux, flux, 1e-5 * flux);  // every particle leaves the bare disk: exact up to float sums
   for (std::size_t s = 0; s < d.size(); ++s) {
 #if !defined(__SANITIZE_ADDRESS__)
-    // 1 M particles, 512 APLs: measured 3.3-3.6 % at d ≥ 1 at the rotated patches' centres, as for 1 M
-    // rays drawn from the analytic disk (3.2-3.5 %, docs/apl_sets.md): the maps' noise at 2 000 rays per APL
-    // and their bilinear interpolation error. (The target, 3 %, is not met.)
+    // 1 M particles, 512 APLs: measured 2.2-2.3 % at d ≥ 1 at the rotated patches' centres (R 64 maps
+    // smoothed by the fitted σ 3.4° kernel), as for 1 M rays drawn from the analytic disk (2.1-2.4 %,
+    // docs/apl_sets.md); the target is 3 %.
     if (d[s] >= 1) {
-      EXPECT_LT(e[s], 0.04) << "d = " << d[s];
+      EXPECT_LT(e[s], 0.03) << "d = " << d[s];
     }
 #endif
     EXPECT_LT(e[s], 0.25) << "d = " << d[s];
@@ -183,10 +183,9 @@ TEST(BakeExactIrradiance, IntegratingSphere) {
   for (std::size_t s = 0; s < d.size(); ++s) {
     if (d[s] < 1) continue;  // spheres of d < 1 cut through the luminaire, whose wall the formula ignores
 #if !defined(__SANITIZE_ADDRESS__)
-    // 1 M particles, 279 000 exits: measured 5.8, 8.2, 5.6, 4.8 % at d = 1, 2, 5, 10. Not noise alone:
-    // 3.6 M particles (1 M exits, as many as the disk's) give 4.9, 8.0, 5.1, 3.9 %, where the fitted
-    // resolution is R 16 for the finer levels; levels 0–1 at R 32 reach 3.3–5.4 %.
-    EXPECT_LT(e[s], 0.10) << "d = " << d[s];
+    // 1 M particles, 279 000 exits: measured 5.2, 4.6, 4.4, 4.2 % at d = 1, 2, 5, 10 (R 32, no kernel:
+    // the peak guard refuses them); the target, 3 %, is not met.
+    EXPECT_LT(e[s], 0.065) << "d = " << d[s];
 #endif
     EXPECT_LT(e[s], 0.25) << "d = " << d[s];
   }
