@@ -464,6 +464,9 @@ TEST(RaysetBadInput, TextFormatsAreLocatedByLine) {
        "lt_length_units"},
       {"Zemax: count mismatch", "3 4 0 0 0 0 0\n1 2 3 0 0 1 1\n1 2 3 0 0 1 1\n", 1, "number of rays"},
       {"Zemax: unit code 7", "1 7 0 0 0 0 0\n1 2 3 0 0 1 1\n", 1, "dimension units"},
+      // Found by the fuzzer: a code beyond int64 was cast before it was checked (undefined behaviour).
+      {"Zemax: unit code 5e21", "1 5000000000000000000008 0 0 0 0 0\n1 2 3 0 0 1 1\n", 1, "dimension units"},
+      {"Zemax: unit code -1e300", "1 -1e300 0 0 0 0 0\n1 2 3 0 0 1 1\n", 1, "dimension units"},
       {"Zemax: fractional count", "1.5 4 0 0 0 0 0\n1 2 3 0 0 1 1\n", 1, "number of rays"},
   };
   for (const Case& c : cases) {

@@ -122,6 +122,50 @@ class IntensityTable {
     return phi;
   }
 
+  /// Luminous flux (lm) emitted into horizontal angles [h_min, h_max] (degrees; a span of at most 360),
+  /// every polar angle: the exact integral of the bilinear interpolant, as flux_lm() (the azimuthal
+  /// interpolant is linear, so each clipped plane interval is a trapezoid). Wraps when the planes cover
+  /// the circle. For Types A and B, whose polar axis is horizontal, [−90, 90] is the downward hemisphere
+  /// (z = −cos V cos H < 0). Returns 0 for an empty or non-finite range.
+  double flux_lm_horizontal(double h_min_deg, double h_max_deg) const {
+    if (!std::isfinite(h_min_deg) || !std::isfinite(h_max_deg) || !(h_max_deg > h_min_deg)) return 0.0;
+    h_max_deg = std::min(h_max_deg, h_min_deg + 360.0);
+    const std::size_t nh = az_.size(), nt = th_.size();
+    const auto column_integral = [&](std::size_t ih) {
+      const double* col = &cd_[ih * nt];
+      double sum = 0;
+      for (std::size_t j = 0; j + 1 < nt; ++j) {  // ∫ over θ of the column's linear pieces times sin θ
+        const double t0 = th_[j] * kDegToRad, t1 = th_[j + 1] * kDegToRad, dt = t1 - t0;
+        const double s = std::cos(t0) - std::cos(t1);
+        const double k = (-(t1 - t0) * std::cos(t1) + std::sin(t1)) - std::sin(t0);
+        sum += col[j] * (s - k / dt) + col[j + 1] * (k / dt);
+      }
+      return sum;
+    };
+    if (nh == 1) return (h_max_deg - h_min_deg) * kDegToRad * column_integral(0);  // no azimuthal variation
+    if (periodic_) {  // the range from [az0, az0 + 360): two turns of the planes then cover it
+      const double shift = 360.0 * std::floor((h_min_deg - az_.front()) / 360.0);
+      h_min_deg -= shift;
+      h_max_deg -= shift;
+    }
+    std::vector<double> g(nh);
+    for (std::size_t i = 0; i < nh; ++i) g[i] = column_integral(i);
+    const auto segment = [&](double a, double ga, double b, double gb) {  // ∫ over [a, b] ∩ [h_min, h_max]
+      const double lo = std::max(a, h_min_deg), hi = std::min(b, h_max_deg);
+      if (!(hi > lo)) return 0.0;
+      const auto at = [&](double x) { return ga + (gb - ga) * (x - a) / (b - a); };
+      return 0.5 * (hi - lo) * (at(lo) + at(hi));
+    };
+    double sum = 0;
+    for (int turn = 0; turn < (periodic_ ? 2 : 1); ++turn) {
+      const double shift = 360.0 * turn;
+      for (std::size_t i = 0; i + 1 < nh; ++i) sum += segment(az_[i] + shift, g[i], az_[i + 1] + shift, g[i + 1]);
+      const double gap_end = az_.front() + 360.0;
+      if (periodic_ && gap_end - az_.back() > 1e-12) sum += segment(az_.back() + shift, g[nh - 1], gap_end + shift, g[0]);
+    }
+    return sum * kDegToRad;
+  }
+
  private:
   // Bilinear lookup in (azimuth, theta), both degrees.
   double lookup(double az, double theta) const {

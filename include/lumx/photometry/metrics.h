@@ -77,26 +77,14 @@ inline Spread spread(const IntensityTable& t, SpreadPlane plane) {
   return s;
 }
 
-/// Fraction of the flux emitted downwards (direction z < 0), in [0, 1]. Exact for Type C (the polar
-/// integral split at gamma = 90); for Types A and B, whose polar axis is horizontal, a midpoint rule on
-/// a 0.25 x 0.25 degree (C, gamma) grid (error well below 1e-3 for tabulated data).
+/// Fraction of the flux emitted downwards (direction z < 0), in [0, 1], exact for the table's bilinear
+/// interpolant: for Type C the polar integral split at gamma = 90; for Types A and B, whose polar axis is
+/// horizontal, the horizontal angles H in [−90, 90] (z = −cos V cos H).
 inline double downward_flux_fraction(const IntensityTable& t) {
   const double total = t.flux_lm();
   if (!(total > 0)) return 0.0;
   if (t.type() == PhotometricType::C) return t.flux_lm(0.0, 90.0) / total;
-  constexpr int nc = 1440, ng = 720;
-  const double dc = 360.0 / nc, dg = 180.0 / ng;
-  double down = 0, all = 0;
-  for (int jg = 0; jg < ng; ++jg) {
-    const double g = (jg + 0.5) * dg;
-    const double w = std::sin(g * kDegToRad);
-    double ring = 0;
-    for (int ic = 0; ic < nc; ++ic)
-      ring += t.intensity(direction_from_angles(PhotometricType::C, (ic + 0.5) * dc, g));
-    all += ring * w;
-    if (g < 90.0) down += ring * w;
-  }
-  return all > 0 ? down / all : 0.0;
+  return std::clamp(t.flux_lm_horizontal(-90.0, 90.0) / total, 0.0, 1.0);
 }
 
 /// Datasheet summary of a Photometry.

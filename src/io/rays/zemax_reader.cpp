@@ -162,7 +162,9 @@ std::unique_ptr<RaySource> open_zemax_text(std::shared_ptr<const RayFile> file, 
     throw_at_line(path, header_line, "number of rays",
                   format_number_9(count) + " rays exceed RaysetLimits::max_rays (" + std::to_string(o.limits.max_rays) + ")");
   const double code = values[1];
-  const auto unit = code == std::floor(code) ? zemax_unit(static_cast<std::int64_t>(code)) : std::nullopt;
+  // A whole number within int64 range before the cast (5e21 or ±inf would make it undefined).
+  const auto unit = code == std::floor(code) && std::abs(code) < 1e15 ? zemax_unit(static_cast<std::int64_t>(code))
+                                                                      : std::nullopt;
   if (!unit)
     throw_at_line(path, header_line, "dimension units", "unknown code " + format_number_9(code) + " (0 m, 1 in, 2 cm, 3 ft, 4 mm)");
 
