@@ -89,7 +89,10 @@ void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lu
     for (std::size_t k = 0; k < r.resolution.size(); ++k) {
       std::printf(" %d", r.resolution[k]);
       const std::vector<double>& kappa = r.held_out.choice.kappa;
-      if (k < kappa.size() && kappa[k] > 0) std::printf(" (kernel σ %.1f°)", 180.0 / lumx::kPi / std::sqrt(kappa[k]));
+      const std::vector<bool>& sharpened = r.held_out.choice.sharpened;
+      if (k < kappa.size() && kappa[k] > 0)
+        std::printf(" (kernel σ %.1f°%s)", 180.0 / lumx::kPi / std::sqrt(kappa[k]),
+                    k < sharpened.size() && sharpened[k] ? ", sharpened" : "");
     }
     std::printf(" (levels 0..%zu)\n", r.resolution.size() - 1);
   }
@@ -100,7 +103,9 @@ void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lu
                                                                                 : "rays in lm",
                 r.far_field_resolution,
                 r.far_field_kernel_sigma_deg > 0
-                    ? (", kernel σ " + std::to_string(r.far_field_kernel_sigma_deg).substr(0, 4) + "°").c_str()
+                    ? (", kernel σ " + std::to_string(r.far_field_kernel_sigma_deg).substr(0, 4) + "°" +
+                       (r.far_field_kernel_sharpened ? ", sharpened" : ""))
+                          .c_str()
                     : "");
   std::printf("bundle:   %s, %llu bytes; evaluation %.2f s, far field %.2f s, writing %.2f s; %.2f s in all\n",
               a.out.c_str(), (unsigned long long)r.bytes, r.seconds_evaluation, r.seconds_far_field, r.seconds_write,

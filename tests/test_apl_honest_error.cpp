@@ -256,8 +256,9 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
     levels.push_back(row_errors([&](const glm::vec3& x, const glm::vec3& n) {
       return luminance_of(set.channels, irradiance(set, k, x, n).irradiance);
     }));
-    std::printf("  %4zu APLs R %3d σ %4.1f°:", set.levels[k].size(), set.levels[k].map_resolution,
-                choice.kappa.at(k) > 0 ? 180.0 / kPi / std::sqrt(choice.kappa.at(k)) : 0.0);
+    std::printf("  %4zu APLs R %3d σ %4.1f°%s:", set.levels[k].size(), set.levels[k].map_resolution,
+                choice.kappa.at(k) > 0 ? 180.0 / kPi / std::sqrt(choice.kappa.at(k)) : 0.0,
+                choice.sharpened.at(k) ? " sharpened" : "");
     for (double e : levels.back()) std::printf(" %6.2f", 100 * e);
     std::printf("\n");
   }
@@ -269,9 +270,10 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // that grid (2.5° × 1°), as irradiance at the d ≥ 2 points from the bounding-sphere centre.
   {
     AplSet far_set = set;
-    far_set.levels[0] = fitted_level(built_level0, choice.far_field_resolution, choice.far_field_kappa);
-    std::printf("  far field maps fitted at d = 5, 10: R %d, kernel κ %.0f\n", choice.far_field_resolution,
-                choice.far_field_kappa);
+    far_set.levels[0] = fitted_level(built_level0, choice.far_field_resolution, choice.far_field_kappa,
+                                     choice.far_field_sharpened);
+    std::printf("  far field maps fitted at d = 5, 10: R %d, kernel κ %.0f%s\n", choice.far_field_resolution,
+                choice.far_field_kappa, choice.far_field_sharpened ? " sharpened" : "");
     const Photometry from_map = far_field_photometry(far_set, 0), from_rays = far_field_from_rays(*rays);
     const IntensityTable tm(from_map), tr(from_rays);
     const auto ies_row = [&](const IntensityTable& t) {
@@ -304,12 +306,14 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   for (std::size_t s = 0; s < ms.sphere_count(); ++s)
     for (std::size_t k = 1; k < levels.size(); ++k)
       EXPECT_LE(levels[k][s], far[s] + 0.01) << set.levels[k].size() << " APLs, d = " << ms.relative_distances()[s];
-  // Regression guards at what the fitted, smoothed maps reach today (2.1-2.4 %; the target is
-  // 2 %, docs/apl_sets.md): the finest level at d ≥ 1 for the Lambertian emitters.
-  if (GetParam() <= 1) {
+  // The finest level at d ≥ 1, as the sharpened, fitted maps reach it (docs/apl_sets.md): the disk
+  // 1.89-1.96 % (the target, 2 %), the rectangle 1.95-2.07 %, the cos^20 spot 1.93-4.32 %, the
+  // cos^50 spot 3.0-11.3 % (what 1 M rays allow a lobe of 0.12 sr at single points: see the docs).
+  const double guard[] = {0.02, 0.022, 0.05, 0.125};
+  if (GetParam() <= 3) {
     for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
       if (ms.relative_distances()[s] >= 1) {
-        EXPECT_LT(levels.back()[s], 0.028) << ms.relative_distances()[s];
+        EXPECT_LT(levels.back()[s], guard[GetParam()]) << ms.relative_distances()[s];
       }
     }
   }

@@ -624,23 +624,27 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
 // and might afford one step finer — the choice is the conservative one.
 
 /// One candidate of the fit: maps at `resolution`, smoothed by the von Mises–Fisher kernel of
-/// concentration `kappa` (1/rad²; 0: not smoothed), and its Σ_d log ε(d).
+/// concentration `kappa` (1/rad²; 0: not smoothed), sharpened when `sharpened` (SphereMapKernel::
+/// apply_sharpened), and its Σ_d log ε(d).
 struct FitCandidate {
   int resolution = 0;
   double kappa = 0;
   double cost = 0;
+  bool sharpened = false;
 };
 
 /// Per level, the chosen resolution and kernel and every candidate tried (finest first).
 struct ResolutionChoice {
   std::vector<int> resolution;                        ///< per level
   std::vector<double> kappa;                          ///< per level: the kernel's κ (0: none)
+  std::vector<bool> sharpened;                        ///< per level: the kernel is sharpened (sharpening_gain)
   std::vector<std::vector<FitCandidate>> tried;       ///< per level
   /// The resolution of level 0's maps for the far field alone (IES/EULUMDAT export), fitted at d = 5 and
   /// 10 on patches of R 64 (3° wide): a far field needs angular detail the near field's compromise can
   /// give away (evaluate_held_out_fitted). 0 when not fitted.
   int far_field_resolution = 0;
   double far_field_kappa = 0;  ///< and its kernel (0: none)
+  bool far_field_sharpened = false;  ///< and sharpened
 };
 
 /// The patch resolution fit_map_resolutions grades on in evaluate_held_out_fitted, for `rays` fitting rays
@@ -666,15 +670,29 @@ inline AplLevel downsampled_level(const AplLevel& level, int R) {
   return out;
 }
 
-/// The level's maps smoothed by `kernel` (whose resolution must be theirs), on up to `threads` threads (0:
-/// the hardware's); each map is smoothed alone, so the result does not depend on the thread count.
-inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& kernel, unsigned threads = 0) {
+/// The level's maps smoothed by `kernel` (whose resolution must be theirs; sharpened when `sharpened`), on up
+/// to `threads` threads (0: the hardware's); each map is smoothed alone, so the result does not depend on
+/// the thread count.
+inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& kernel, unsigned threads = 0,
+                               bool sharpened = false) {
   AplLevel out = level;
   const std::size_t n = out.apls.size();
   if (threads == 0) threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   threads = unsigned(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 8)));
+  // Sharpened: one gain from the level's sum (its far field) for every map (SphereMapKernel::apply_with_gain).
+  SphereMap gain;
+  if (sharpened && n > 0) {
+    SphereMap total(kernel.resolution(), 1);
+    for (const Apl& a : level.apls) {
+      const int C = a.map.channels();
+      for (std::size_t t = 0; t < total.texel_count(); ++t)
+        for (int c = 0; c < C; ++c) total.data()[t] += a.map.data()[t * std::size_t(C) + std::size_t(c)];
+    }
+    gain = kernel.sharpening_gain(total);
+  }
   const auto run = [&](std::size_t from, std::size_t to) {
-    for (std::size_t i = from; i < to; ++i) out.apls[i].map = kernel.apply(level.apls[i].map);
+    for (std::size_t i = from; i < to; ++i)
+      out.apls[i].map = sharpened ? kernel.apply_with_gain(level.apls[i].map, gain) : kernel.apply(level.apls[i].map);
   };
   if (threads <= 1) {
     run(0, n);
@@ -686,10 +704,11 @@ inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& ker
   return out;
 }
 
-/// The fitted maps of a level: downsampled to R, then smoothed by the kernel of κ when κ > 0.
-inline AplLevel fitted_level(const AplLevel& level, int R, double kappa) {
+/// The fitted maps of a level: downsampled to R, then smoothed by the kernel of κ when κ > 0 (sharpened when
+/// `sharpened`).
+inline AplLevel fitted_level(const AplLevel& level, int R, double kappa, bool sharpened = false) {
   AplLevel out = downsampled_level(level, R);
-  if (kappa > 0) out = smoothed_level(out, *SphereMapKernel::shared(R, kappa));
+  if (kappa > 0) out = smoothed_level(out, *SphereMapKernel::shared(R, kappa), 0, sharpened);
   return out;
 }
 
@@ -704,6 +723,24 @@ inline std::vector<double> fit_kernel_kappas(int R) {
   return out;
 }
 
+/// A kernel the fit tries: κ (1/rad²) and whether it is sharpened.
+struct FitKernel {
+  double kappa = 0;
+  bool sharpened = false;
+};
+
+/// The kernels the fit tries at resolution R: fit_kernel_kappas(R) as they are, and sharpened
+/// (SphereMapKernel::sharpening_gain: bias O(κ⁻²), so a spot's lobe keeps its peak) at σ = 1.5 and 3
+/// texel widths.
+inline std::vector<FitKernel> fit_kernels(int R) {
+  std::vector<FitKernel> out;
+  for (double kappa : fit_kernel_kappas(R)) out.push_back({kappa, false});
+  if (R < 32 || R > SphereMapKernel::kMaxResolution) return out;
+  const double texel = std::sqrt(4.0 * kPi / (2.0 * double(R) * double(R)));
+  for (double widths : {0.75, 1.5, 3.0}) out.push_back({1.0 / ((widths * texel) * (widths * texel)), true});
+  return out;
+}
+
 /// How much a kernel lowers a level's brightest directions, relative, and how much their mean may move by
 /// its own noise. The level's maps are summed (its far field); the brightest directions are the texels of
 /// the smoothed sum, brightest first, that hold 5 % of its flux (chosen on the smoothed map, so that texels
@@ -711,7 +748,7 @@ inline std::vector<double> fit_kernel_kappas(int R) {
 /// plain sum's mean over them, and the allowance 2/√n, n = set_rays · (their share of the plain flux)
 /// (the rays that fell there, for rays of equal flux). Returns {lowering, allowance}.
 inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const SphereMapKernel& kernel,
-                                                    std::uint64_t set_rays) {
+                                                    std::uint64_t set_rays, bool sharpened = false) {
   const int R = level.map_resolution;
   if (level.apls.empty() || set_rays == 0) return {1.0, 0.0};
   SphereMap sum(R, 1);
@@ -721,7 +758,7 @@ inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const
     for (std::size_t t = 0; t < sum.texel_count(); ++t)
       for (int c = 0; c < C; ++c) sum.data()[t] += v[t * std::size_t(C) + std::size_t(c)];
   }
-  const SphereMap smooth = kernel.apply(sum);
+  const SphereMap smooth = sharpened ? kernel.apply_sharpened(sum) : kernel.apply(sum);
   std::vector<std::uint32_t> order(sum.texel_count());
   for (std::size_t t = 0; t < order.size(); ++t) order[t] = std::uint32_t(t);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -741,6 +778,9 @@ inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const
   return {(plain - smoothed) / plain, 2.0 / std::sqrt(std::max(1.0, rays_there))};
 }
 
+/// The error beyond which the kernel guard of fit_map_resolutions does not protect a distance (relative RMSE).
+inline constexpr double kUnusableError = 0.25;
+
 /// Chooses each level's map resolution, from its own down to `min_resolution`, and kernel (none, or one of
 /// fit_kernel_kappas), by the error against `ref` (held-out rays: see above), and fits the levels of `set`.
 /// `set_rays`: the number of rays `set` was built from (0: unknown, and then no kernel is tried).
@@ -754,7 +794,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     const AplLevel built = set.levels[k];
     std::vector<FitCandidate> tried;
     FitCandidate best{built.map_resolution, 0.0, INFINITY};
-    const auto grade = [&](int R, double kappa, std::vector<double>& errors) {
+    const auto grade = [&](int R, double kappa, bool sharpened, std::vector<double>& errors) {
       const LevelErrors row = evaluate_level(set, k, ref, o);
       double cost = 0;
       errors.clear();
@@ -762,7 +802,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         errors.push_back(e.relative_rmse);
         if (std::isfinite(e.relative_rmse) && e.relative_rmse > 0) cost += std::log(e.relative_rmse);
       }
-      tried.push_back({R, kappa, cost});
+      tried.push_back({R, kappa, cost, sharpened});
       return cost;
     };
     double plain_before = INFINITY;
@@ -770,22 +810,27 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     for (int R = built.map_resolution; R >= std::max(1, min_resolution); R /= 2) {
       const AplLevel at_r = downsampled_level(built, R);
       set.levels[k] = at_r;
-      const double plain = grade(R, 0.0, plain_errors);
+      const double plain = grade(R, 0.0, false, plain_errors);
       if (plain < best.cost) best = tried.back();
-      for (double kappa : set_rays > 0 ? fit_kernel_kappas(R) : std::vector<double>{}) {
+      for (const FitKernel& kernel : set_rays > 0 ? fit_kernels(R) : std::vector<FitKernel>{}) {
+        const double kappa = kernel.kappa;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where
         // the fit's patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7°
         // lowered the peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10).
-        const auto [lowering, allowance] = kernel_peak_change(at_r, *kernel_for(R, kappa), set_rays);
+        const auto [lowering, allowance] = kernel_peak_change(at_r, *kernel_for(R, kappa), set_rays, kernel.sharpened);
         if (lowering > allowance) continue;
-        set.levels[k] = smoothed_level(at_r, *kernel_for(R, kappa));
-        const double cost = grade(R, kappa, kernel_errors);
+        set.levels[k] = smoothed_level(at_r, *kernel_for(R, kappa), 0, kernel.sharpened);
+        const double cost = grade(R, kappa, kernel.sharpened, kernel_errors);
         // A kernel must not give away any distance against the same maps unsmoothed: its bias is largest at
         // a narrow peak, which the fit's patches (coarser than the peak) see only in part, at some distances
         // (a cos^50 spot: σ 1.7° won the geometric mean by the near field and doubled the error at d ≥ 5).
+        // Distances where the level is off by more than 25 % unsmoothed are not protected: no error target
+        // uses it there (a one-APL level near a spot: 340 % either way), and a sharper far field, right at
+        // d ≥ 5, is worse there by what the point model misses.
         bool no_worse = true;
         for (std::size_t s = 0; s < kernel_errors.size() && s < plain_errors.size(); ++s)
-          if (std::isfinite(plain_errors[s]) && !(kernel_errors[s] <= plain_errors[s])) no_worse = false;
+          if (std::isfinite(plain_errors[s]) && plain_errors[s] <= kUnusableError && !(kernel_errors[s] <= plain_errors[s]))
+            no_worse = false;
         if (no_worse && cost < best.cost) best = tried.back();
       }
       // Past the minimum: coarser maps trade noise for blur, and once halving made them worse and the best
@@ -794,9 +839,11 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       plain_before = plain;
     }
     set.levels[k] = downsampled_level(built, best.resolution);
-    if (best.kappa > 0) set.levels[k] = smoothed_level(set.levels[k], *kernel_for(best.resolution, best.kappa));
+    if (best.kappa > 0)
+      set.levels[k] = smoothed_level(set.levels[k], *kernel_for(best.resolution, best.kappa), 0, best.sharpened);
     choice.resolution.push_back(best.resolution);
     choice.kappa.push_back(best.kappa);
+    choice.sharpened.push_back(best.kappa > 0 && best.sharpened);
     choice.tried.push_back(std::move(tried));
   }
   return choice;
@@ -840,6 +887,7 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
     const ResolutionChoice far_choice = fit_map_resolutions(far, far_ref, far_options, min_resolution, train_rays);
     c.far_field_resolution = far_choice.resolution.at(0);
     c.far_field_kappa = far_choice.kappa.at(0);
+    c.far_field_sharpened = far_choice.sharpened.at(0);
   }
   RayHalf test(odd, 1);
   AplErrorReport report = evaluate_apl_errors(set, test, options);
@@ -891,7 +939,8 @@ inline bool apply_held_out_fit(AplSet& set, const AplErrorReport& report, const 
     for (std::size_t k = 0; k < set.levels.size() && k < choice->resolution.size(); ++k)
       if (choice->resolution[k] <= set.levels[k].map_resolution)
         set.levels[k] = fitted_level(set.levels[k], choice->resolution[k],
-                                     k < choice->kappa.size() ? choice->kappa[k] : 0.0);
+                                     k < choice->kappa.size() ? choice->kappa[k] : 0.0,
+                                     k < choice->sharpened.size() && choice->sharpened[k]);
   store_error_tables(set, report);
   return true;
 }

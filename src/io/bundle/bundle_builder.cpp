@@ -172,7 +172,7 @@ BundleBuildResult build_bundle(RaySource& rays, const std::string& out, const Bu
     const int fitted_r = result.held_out.choice.far_field_resolution;
     const double fitted_kappa = result.held_out.choice.far_field_kappa;
     far_set.levels.push_back(fitted_r > 0 && fitted_r <= built_level0.map_resolution
-                                 ? fitted_level(built_level0, fitted_r, fitted_kappa)
+                                 ? fitted_level(built_level0, fitted_r, fitted_kappa, result.held_out.choice.far_field_sharpened)
                                  : set.levels.at(0));
     const Photometry far = far_field_photometry(far_set, 0, grid);
     wo.attachments.push_back({"far_field.ies", "application/x-ies-lm63", format_ies(far)});
@@ -182,6 +182,7 @@ BundleBuildResult build_bundle(RaySource& rays, const std::string& out, const Bu
     result.far_field_resolution = far_set.levels[0].map_resolution;
     result.far_field_kernel_sigma_deg =
         fitted_r > 0 && fitted_kappa > 0 ? 180.0 / kPi / std::sqrt(fitted_kappa) : 0.0;
+    result.far_field_kernel_sharpened = result.far_field_kernel_sigma_deg > 0 && result.held_out.choice.far_field_sharpened;
   }
   const auto far_done = Clock::now();
   for (const auto& attachment : o.attachments) wo.attachments.push_back(attachment);
