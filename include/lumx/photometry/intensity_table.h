@@ -85,33 +85,10 @@ class IntensityTable {
   /// integral of the bilinear interpolant. Defaults give the total flux. For Type C theta is gamma, so
   /// [0, 90] is the downward (lower-hemisphere) flux.
   double flux_lm(double theta_min_deg = 0.0, double theta_max_deg = 180.0) const {
-    const std::size_t nt = th_.size();
-    const double a = std::max(theta_min_deg, th_.front()) * kDegToRad;
-    const double b = std::min(theta_max_deg, th_.back()) * kDegToRad;
-    if (!(b > a)) return 0.0;
-    // Per polar cell j: weights of its lower (w0) and upper (w1) row, integrated over the clipped span.
-    std::vector<double> w0(nt, 0.0), w1(nt, 0.0);
-    for (std::size_t j = 0; j + 1 < nt; ++j) {
-      const double t0 = th_[j] * kDegToRad, t1 = th_[j + 1] * kDegToRad;
-      const double lo = std::max(a, t0), hi = std::min(b, t1);
-      if (!(hi > lo)) continue;
-      const double dt = t1 - t0;
-      const double s = std::cos(lo) - std::cos(hi);                        // int sin
-      const double k = (-(hi - t0) * std::cos(hi) + std::sin(hi)) -        // int (t - t0) sin t
-                       (-(lo - t0) * std::cos(lo) + std::sin(lo));
-      w1[j] = k / dt;
-      w0[j] = s - k / dt;
-    }
-    auto column_integral = [&](std::size_t ih) {
-      const double* col = &cd_[ih * nt];
-      double sum = 0;
-      for (std::size_t j = 0; j + 1 < nt; ++j) sum += col[j] * w0[j] + col[j + 1] * w1[j];
-      return sum;
-    };
+    const std::vector<double> colint = polar_integrals(theta_min_deg, theta_max_deg);
+    if (colint.empty()) return 0.0;
     const std::size_t nh = az_.size();
-    if (nh == 1) return 2.0 * kPi * column_integral(0);
-    std::vector<double> colint(nh);
-    for (std::size_t i = 0; i < nh; ++i) colint[i] = column_integral(i);
+    if (nh == 1) return 2.0 * kPi * colint[0];
     double phi = 0;
     for (std::size_t i = 0; i + 1 < nh; ++i)
       phi += 0.5 * (az_[i + 1] - az_[i]) * kDegToRad * (colint[i] + colint[i + 1]);
@@ -130,26 +107,15 @@ class IntensityTable {
   double flux_lm_horizontal(double h_min_deg, double h_max_deg) const {
     if (!std::isfinite(h_min_deg) || !std::isfinite(h_max_deg) || !(h_max_deg > h_min_deg)) return 0.0;
     h_max_deg = std::min(h_max_deg, h_min_deg + 360.0);
-    const std::size_t nh = az_.size(), nt = th_.size();
-    const auto column_integral = [&](std::size_t ih) {
-      const double* col = &cd_[ih * nt];
-      double sum = 0;
-      for (std::size_t j = 0; j + 1 < nt; ++j) {  // ∫ over θ of the column's linear pieces times sin θ
-        const double t0 = th_[j] * kDegToRad, t1 = th_[j + 1] * kDegToRad, dt = t1 - t0;
-        const double s = std::cos(t0) - std::cos(t1);
-        const double k = (-(t1 - t0) * std::cos(t1) + std::sin(t1)) - std::sin(t0);
-        sum += col[j] * (s - k / dt) + col[j + 1] * (k / dt);
-      }
-      return sum;
-    };
-    if (nh == 1) return (h_max_deg - h_min_deg) * kDegToRad * column_integral(0);  // no azimuthal variation
+    const std::size_t nh = az_.size();
+    const std::vector<double> g = polar_integrals(th_.front(), th_.back());
+    if (g.empty()) return 0.0;
+    if (nh == 1) return (h_max_deg - h_min_deg) * kDegToRad * g[0];  // no azimuthal variation
     if (periodic_) {  // the range from [az0, az0 + 360): two turns of the planes then cover it
       const double shift = 360.0 * std::floor((h_min_deg - az_.front()) / 360.0);
       h_min_deg -= shift;
       h_max_deg -= shift;
     }
-    std::vector<double> g(nh);
-    for (std::size_t i = 0; i < nh; ++i) g[i] = column_integral(i);
     const auto segment = [&](double a, double ga, double b, double gb) {  // ∫ over [a, b] ∩ [h_min, h_max]
       const double lo = std::max(a, h_min_deg), hi = std::min(b, h_max_deg);
       if (!(hi > lo)) return 0.0;
@@ -167,6 +133,34 @@ class IntensityTable {
   }
 
  private:
+  /// For every plane i, ∫ I(h_i, θ) sin θ dθ over [θ_min, θ_max] ∩ the table's span (degrees in, θ in
+  /// radians inside): the exact integral of the column's linear pieces, each cell's lower and upper value
+  /// weighted by ∫ (1 − u) sin θ and ∫ u sin θ over its clipped part. Empty when the span is.
+  std::vector<double> polar_integrals(double theta_min_deg, double theta_max_deg) const {
+    const std::size_t nt = th_.size(), nh = az_.size();
+    const double a = std::max(theta_min_deg, th_.front()) * kDegToRad;
+    const double b = std::min(theta_max_deg, th_.back()) * kDegToRad;
+    if (!(b > a)) return {};
+    std::vector<double> w0(nt, 0.0), w1(nt, 0.0);
+    for (std::size_t j = 0; j + 1 < nt; ++j) {
+      const double t0 = th_[j] * kDegToRad, t1 = th_[j + 1] * kDegToRad;
+      const double lo = std::max(a, t0), hi = std::min(b, t1);
+      if (!(hi > lo)) continue;
+      const double dt = t1 - t0;
+      const double s = std::cos(lo) - std::cos(hi);                        // ∫ sin t
+      const double k = (-(hi - t0) * std::cos(hi) + std::sin(hi)) -        // ∫ (t − t0) sin t
+                       (-(lo - t0) * std::cos(lo) + std::sin(lo));
+      w1[j] = k / dt;
+      w0[j] = s - k / dt;
+    }
+    std::vector<double> out(nh, 0.0);
+    for (std::size_t i = 0; i < nh; ++i) {
+      const double* col = &cd_[i * nt];
+      for (std::size_t j = 0; j + 1 < nt; ++j) out[i] += col[j] * w0[j] + col[j + 1] * w1[j];
+    }
+    return out;
+  }
+
   // Bilinear lookup in (azimuth, theta), both degrees.
   double lookup(double az, double theta) const {
     const std::size_t nt = th_.size();
