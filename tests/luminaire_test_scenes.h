@@ -103,9 +103,17 @@ struct Hole {
   double u, v, half;
 };
 
-/// Cube [−s, s]³ whose faces face inwards, with square holes, meshed on an n × n grid per face; a cell is
-/// left out when its centre lies in a hole, so holes must be aligned with the grid (hole() below does it).
-inline void add_box_with_holes(SceneBuilder& b, double s, int n, const std::vector<Hole>& holes) {
+/// Axis-aligned rectangular hole on a cube face: face axis, side (+1/−1), and its extent [u0, u1] × [v0, v1]
+/// in the face's other two coordinates (in increasing axis order).
+struct RectHole {
+  int axis;
+  int side;
+  double u0, u1, v0, v1;
+};
+
+/// Cube [−s, s]³ whose faces face inwards, with rectangular holes, meshed on an n × n grid per face; a cell
+/// is left out when its centre lies in a hole, so holes must be aligned with the grid.
+inline void add_box_with_holes(SceneBuilder& b, double s, int n, const std::vector<RectHole>& holes) {
   for (int axis = 0; axis < 3; ++axis)
     for (int side : {-1, 1}) {
       const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
@@ -116,10 +124,10 @@ inline void add_box_with_holes(SceneBuilder& b, double s, int n, const std::vect
           const double v0 = -s + 2 * s * j / n, v1 = -s + 2 * s * (j + 1) / n;
           const double uc = 0.5 * (u0 + u1), vc = 0.5 * (v0 + v1);
           bool in_hole = false;
-          for (const Hole& h : holes) {
+          for (const RectHole& h : holes) {
             if (h.axis != axis || h.side != side) continue;
             const double cu = ua == lo_axis ? uc : vc, cv = ua == lo_axis ? vc : uc;
-            if (std::abs(cu - h.u) < h.half && std::abs(cv - h.v) < h.half) in_hole = true;
+            if (cu > h.u0 && cu < h.u1 && cv > h.v0 && cv < h.v1) in_hole = true;
           }
           if (in_hole) continue;
           auto P = [&](double u, double v) {
@@ -137,6 +145,13 @@ inline void add_box_with_holes(SceneBuilder& b, double s, int n, const std::vect
             b.flat_quad(P(u0, v0), P(u1, v0), P(u1, v1), P(u0, v1));
         }
     }
+}
+
+/// Cube [−s, s]³ whose faces face inwards, with square holes (Hole: centre and half size).
+inline void add_box_with_holes(SceneBuilder& b, double s, int n, const std::vector<Hole>& holes) {
+  std::vector<RectHole> rect;
+  for (const Hole& h : holes) rect.push_back({h.axis, h.side, h.u - h.half, h.u + h.half, h.v - h.half, h.v + h.half});
+  add_box_with_holes(b, s, n, rect);
 }
 
 /// Solid angle of the planar triangle (a, b, c) seen from the origin (Van Oosterom & Strackee 1983).

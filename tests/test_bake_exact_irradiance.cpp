@@ -9,6 +9,7 @@
 //   * a point light at the centre of a white Lambertian integrating sphere with a port: outside, the
 //     light through the port is the point source (in the port's cone) plus the port opening as a
 //     Lambertian disk of the wall's uniform radiance;
+//   * two point lights in a black box with holes: each light's inverse-square field where a hole lets it out;
 //   * a point light at the focus of a paraboloid mirror: the baked far field stays inside its cone.
 #include "analytic_emitters.h"
 #include "luminaire_test_scenes.h"
@@ -51,7 +52,8 @@ struct ExitCollector : lumx::bake::ParticleSink {
 /// level for the record.
 std::vector<double> baked_point_errors(const LuminaireScene& scene, const std::function<double(const glm::dvec3&, const glm::dvec3&)>& exact,
                                        double* exit_flux, std::vector<double>* distances,
-                                       std::uint64_t particles = kParticles) {
+                                       std::uint64_t particles = kParticles, std::vector<double>* radii = nullptr,
+                                       glm::dvec3* centre = nullptr) {
   const lumx::bake::Tracer tracer(scene);
   lumx::bake::TraceOptions o;
   o.particles = particles;
@@ -75,6 +77,9 @@ std::vector<double> baked_point_errors(const LuminaireScene& scene, const std::f
   const lumx::MeasurementSpheres ms(set.bounds, eo);
   const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);
   *distances = ms.relative_distances();
+  if (radii)
+    for (std::size_t s = 0; s < ms.sphere_count(); ++s) radii->push_back(ms.radius(s));
+  if (centre) *centre = ms.centre();
   std::vector<double> finest;
   std::printf("%s: %llu particles, %zu exits, %.4g lm; point error against the exact irradiance, %%, at d =", scene.name.c_str(),
               (unsigned long long)particles, exits.rays.size(), flux);
@@ -190,6 +195,49 @@ TEST(BakeExactIrradiance, IntegratingSphere) {
 #endif
     EXPECT_LT(e[s], 0.25) << "d = " << d[s];
   }
+}
+
+// Two isotropic point lights (500 lm each) inside a black 10 cm box with four rectangular holes — the
+// analytic suite's box (tests/test_apl_honest_error.cpp) as geometry: outside, the exact irradiance is each
+// light's inverse-square field where the straight line to it passes through a hole (PinholeBox), with sharp
+// shadow borders no map of finite resolution resolves at every point.
+TEST(BakeExactIrradiance, PointLightsInABoxWithHoles) {
+  SceneBuilder b("baked box with holes");
+  const double half = 0.05, flux = 500.0;
+  const std::vector<RectHole> holes = {{2, 1, -0.03, 0.01, -0.02, 0.03},
+                                       {2, -1, 0.0, 0.03, -0.03, 0.0},
+                                       {0, 1, -0.04, -0.01, -0.01, 0.03},
+                                       {1, -1, -0.02, 0.02, -0.045, -0.02}};
+  b.begin_part("box", b.add_material(black()));
+  add_box_with_holes(b, half, 20, holes);  // 5 mm cells: every hole edge lies on the grid
+  const std::vector<glm::dvec3> lights = {{-0.02, 0.01, 0.0}, {0.015, -0.01, 0.01}};
+  for (const glm::dvec3& p : lights) b.point_light(p, flux / (4 * lumx::kPi));
+  std::vector<PinholeBox::Hole> exact_holes;
+  for (const RectHole& h : holes) exact_holes.push_back({h.axis, h.side, h.u0, h.u1, h.v0, h.v1});
+  const PinholeBox exact("box", half, exact_holes, {{lights[0], flux}, {lights[1], flux}});
+  double exit_flux = 0.0;
+  std::vector<double> d, radius;
+  glm::dvec3 centre(0.0);
+  const std::vector<double> e = baked_point_errors(
+      b.scene(), [&](const glm::dvec3& x, const glm::dvec3& n) { return exact.irradiance(x, n); }, &exit_flux, &d,
+      kParticles, &radius, &centre);
+  // The particles leave from the lights (the black walls scatter nothing), so the set's bounding sphere is
+  // the lights' (radius 2.1 cm) and its spheres up to d ≈ 4 pass through the box, where the exact field
+  // is 0 and the APLs know no wall: only spheres wholly outside the box are graded.
+  const double box_reach = glm::length(glm::abs(centre) + glm::dvec3(half));
+  int graded = 0;
+  for (std::size_t s = 0; s < d.size(); ++s) {
+    if (radius[s] <= box_reach) continue;
+    ++graded;
+#if !defined(__SANITIZE_ADDRESS__)
+    // 1 M particles, 112 000 exits: measured 56.6 and 52.3 % at d = 5 and 10, as the same box from rays
+    // drawn analytically (49-53 %, docs/apl_sets.md); the target, 10 %, is not met: the beams' sharp
+    // borders are blurred by the R 32 maps the fit chooses (docs/bake.md).
+    EXPECT_LT(e[s], 0.62) << "d = " << d[s];
+#endif
+    EXPECT_LT(e[s], 1.0) << "d = " << d[s];
+  }
+  EXPECT_GE(graded, 2);
 }
 
 // A point light at the focus of a paraboloid mirror (rim at cos θ = 0.6 from +z), baked: every particle leaves

@@ -591,7 +591,7 @@ TEST(BakeTracer, ThinGlassSlabIsCrossedFaceByFace) {
 TEST(BakeTracer, LuminaireWithoutFluxIsRefusedByName) {
   SceneBuilder b("dark");
   b.begin_part("box", b.add_material(black()));
-  add_box_with_holes(b, 0.05, 2, {});
+  add_box_with_holes(b, 0.05, 2, std::vector<Hole>{});
   try {
     const Tracer tracer(b.scene());
     FAIL() << "expected lumx::Error";
