@@ -235,6 +235,8 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   const AplErrorReport held_out = evaluate_held_out_fitted(*rays, build, eo, &choice);
   AplSet set = build(*rays);
   const AplLevel built_level0 = set.levels.at(0);
+  AplSet as_built = set;  // the resolution rule's maps, unfitted: the default before the held-out fit
+  as_built.levels.erase(as_built.levels.begin(), as_built.levels.end() - 1);
   ASSERT_TRUE(apply_held_out_fit(set, held_out, &choice));
   const MeasurementSpheres ms(set.bounds, eo);
   const ExactOnSpheres exact = exact_on_spheres(*em, ms, 1);
@@ -290,6 +292,29 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
     std::printf("\n  IES, rays     :");
     for (double e : e_rays) std::printf(" %6.2f", 100 * e);
     std::printf("\n");
+    const std::vector<double> before = row_errors([&](const glm::vec3& x, const glm::vec3& n) {
+      return luminance_of(as_built.channels, irradiance(as_built, 0, x, n).irradiance);
+    });
+    std::printf("  %4zu APLs, the rule's R %d, unfitted (before):", as_built.levels[0].size(), as_built.levels[0].map_resolution);
+    for (double e : before) std::printf(" %6.2f", 100 * e);
+    std::printf("\n");
+    // LUMX_FIGURES_DIR: the rows as CSV for scripts/plot_apl_suite.py (docs/images/apl_suite_error.png).
+    if (const char* dir = std::getenv("LUMX_FIGURES_DIR")) {
+      const std::string path = std::string(dir) + "/apl_suite_" + std::to_string(GetParam()) + ".csv";
+      if (FILE* f = std::fopen(path.c_str(), "w")) {
+        std::fprintf(f, "emitter,series,d,relative_rmse\n");
+        const auto rows = [&](const char* series, const std::vector<double>& v) {
+          for (std::size_t s = 0; s < v.size(); ++s)
+            std::fprintf(f, "\"%s\",\"%s\",%g,%.6g\n", em->name().c_str(), series, ms.relative_distances()[s], v[s]);
+        };
+        rows("finest level, fitted and smoothed (shipped)", levels.back());
+        rows("finest level, the rule's R (before the fit)", before);
+        rows("far field, one point", far);
+        rows("IES attachment from level 0's fitted maps", e_map);
+        rows("IES from the rays binned on its grid (before)", e_rays);
+        std::fclose(f);
+      }
+    }
     // For the Lambertian emitters the fitted map is over 3× better than the binned rays at d ≥ 5 (3.3
     // against 11.5 %; at d = 2 the rectangle is still 2.5 m from a 1.2 m source: 6.4 against 12 %); for
     // the spots it is mixed (docs/apl_sets.md), so only the first is asserted.

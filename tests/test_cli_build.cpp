@@ -63,6 +63,14 @@ TEST(CliBuild, StoresAndPrintsHeldOutTablesTheLibraryReproduces) {
   EXPECT_EQ(prov.at("error_tables").rfind("held out", 0), 0u) << prov.at("error_tables");
   EXPECT_EQ(prov.at("source_rays"), "200000");
   ASSERT_EQ(reader.manifest().levels.size(), 3u);
+  // The fitted maps in words: one entry per level with its resolution, and the far field's.
+  const std::string& smoothing = prov.at("map_smoothing");
+  for (std::size_t k = 0; k < 3; ++k)
+    EXPECT_TRUE(has(smoothing, "level " + std::to_string(k) + ": R " +
+                                   std::to_string(reader.manifest().levels[k].map_resolution) + ","))
+        << smoothing;
+  EXPECT_TRUE(has(smoothing, "far field: R ")) << smoothing;
+  std::printf("map_smoothing: %s\n", smoothing.c_str());
 
   // The library on the same file, one thread (the CLI used every core): the same tables and resolutions.
   const auto rays = open_rayset(b.rays.string());
