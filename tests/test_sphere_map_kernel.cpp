@@ -183,11 +183,11 @@ TEST(SphereMapKernel, SharpeningKeepsANarrowLobesPeakWherePlainSmoothingLowersIt
 }
 
 TEST(SphereMapKernel, SharpenedLevelSumsToTheSharpenedSumWhereSharpeningEachMapFlattensIt) {
-  // A level's maps are sparse: 512 APLs share 200 000 rays of one cos^20 lobe at R 64 (~2 rays a lit texel). With one gain from the
+  // A level's maps are sparse: 512 APLs share 50 000 rays of one cos^20 lobe at R 32 (~2 rays a lit texel). With one gain from the
   // level's sum (smoothed_level), the maps sum to the sum's sharpened estimate, up to each map's flux
   // rescaling, and every APL keeps its flux. Sharpening each map alone clamps the negative rings of its
-  // isolated rays and lowers the lobe's peak (here 36 times as much) — the reason for the shared gain.
-  const int R = 64;
+  // isolated rays and lowers the lobe's peak (here 15 times as much) — the reason for the shared gain.
+  const int R = 32;
   const double texel = std::sqrt(4.0 * kPi / (2.0 * R * R));
   const SphereMapKernel k(R, 1.0 / ((1.5 * texel) * (1.5 * texel)));
   AplLevel level;
@@ -197,7 +197,7 @@ TEST(SphereMapKernel, SharpenedLevelSumsToTheSharpenedSumWhereSharpeningEachMapF
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   SphereMap total(R, 1);
-  for (int i = 0; i < 200000; ++i) {
+  for (int i = 0; i < 50000; ++i) {
     const double ct = std::pow(u(rng), 1.0 / 21.0), st = std::sqrt(1 - ct * ct), phi = 2 * kPi * u(rng);
     const glm::vec2 uv = sphere_map::direction_to_uv(glm::vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct)));
     const int x = std::min(2 * R - 1, int(uv.x * 2 * R)), y = std::min(R - 1, int(uv.y * R));
@@ -231,9 +231,10 @@ TEST(SphereMapKernel, SharpenedLevelSumsToTheSharpenedSumWhereSharpeningEachMapF
   const double e = peak_mean(expected), shared_peak = peak_mean(sum_shared), alone_peak = peak_mean(sum_alone);
   std::printf("brightest 5 %%: sharpened sum %.1f, shared gain %.1f (%.3f %%), each map alone %.1f (%.2f %%)\n", e,
               shared_peak, 100 * (shared_peak / e - 1), alone_peak, 100 * (alone_peak / e - 1));
-  // Measured −0.016 % with the shared gain, −0.58 % map by map (the same rays: no noise between them).
-  EXPECT_LT(std::abs(shared_peak / e - 1), 0.001);
-  EXPECT_LT(alone_peak / e - 1, -0.003);
+  // Measured −0.09 % with the shared gain (each map's flux rescaling), −1.35 % map by map (the same rays:
+  // no noise between them).
+  EXPECT_LT(std::abs(shared_peak / e - 1), 0.002);
+  EXPECT_LT(alone_peak / e - 1, -0.006);
   // One thread or two: the same maps.
   const AplLevel one = smoothed_level(level, k, 1, true);
   for (std::size_t i = 0; i < level.apls.size(); ++i) EXPECT_EQ(one.apls[i].map.values(), shared.apls[i].map.values());
