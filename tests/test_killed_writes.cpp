@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
 // SIGKILL during a write: a child process rewrites a file over and over (IES, EULUMDAT, TM-33 XML and
-// JSON, TM-25) and is killed while its temporary exists. The target must then hold one whole version,
+// JSON, TM-25, glTF luminaires as .glb and .gltf) and is killed while its temporary exists. The target must then hold one whole version,
 // byte for byte, and the next write of the same target must leave no temporary behind
 // (docs/robustness.md §4; hard-cases.md §6 item 36).
+#include <lumx/bake/gltf_writer.h>
+#include <lumx/bake/luminaire_builder.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/io/rayset_io.h>
 
@@ -147,5 +149,38 @@ TEST(Robustness, KilledTm25WriteLeavesAWholeFileAndNoTemporaryAfterTheNextWrite)
     MemoryRaySource source(std::move(r), info);
     write_tm25(target.string(), info, source);
   });
+  fs::remove_all(d);
+}
+
+namespace {
+
+/// A luminaire of 47 600 triangles (a white sphere of 120 rings × 200 sectors, smooth normals) as glTF,
+/// binary or with its buffer as a data URI: 4.0 MB as .glb, 5.3 MB as .gltf. `albedo` makes a second version.
+void write_sphere_luminaire(const fs::path& target, double albedo, bool binary) {
+  bake::LuminaireBuilder b("kill");
+  bake::Material m;
+  m.name = "wall";
+  m.base_color = bake::Rgb{albedo};
+  b.begin_part("wall", b.add_material(m));
+  b.sphere(glm::dmat4(1.0), 0.1, 120, 200, 0.0, true);
+  b.point_light({0.0, 0.0, 0.0}, 1.0);
+  bake::GltfWriteOptions o;
+  o.binary = binary;
+  bake::write_gltf_luminaire(b.scene(), target.string(), o);
+}
+
+}  // namespace
+
+TEST(Robustness, KilledGlbWriteLeavesAWholeFileAndNoTemporaryAfterTheNextWrite) {
+  const fs::path d = fresh_dir("glb");
+  const fs::path target = d / "luminaire.glb";
+  expect_kill_leaves_a_whole_file(target, [&](int version) { write_sphere_luminaire(target, version ? 0.5 : 0.8, true); });
+  fs::remove_all(d);
+}
+
+TEST(Robustness, KilledGltfWriteLeavesAWholeFileAndNoTemporaryAfterTheNextWrite) {
+  const fs::path d = fresh_dir("gltf");
+  const fs::path target = d / "luminaire.gltf";
+  expect_kill_leaves_a_whole_file(target, [&](int version) { write_sphere_luminaire(target, version ? 0.5 : 0.8, false); });
   fs::remove_all(d);
 }

@@ -6,6 +6,8 @@
 // the previous file (or bundle) byte for byte, and leave no temporary behind. A crash at that moment would
 // leave the same state, with at most a temporary that the next write removes (tests/test_killed_writes.cpp).
 #include <lumx/apl/apl_set.h>
+#include <lumx/bake/gltf_writer.h>
+#include <lumx/bake/luminaire_builder.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/image_io.h>
 #include <lumx/io/photometry_io.h>
@@ -193,6 +195,28 @@ TEST(SyscallFaults, ExrImageWritesFailingAnywhereKeepTheOldFile) {
   };
   expect_failed_writes_keep_the_old_file(target, [&] { write_image(1); }, [&] { write_image(2); }, 11);
   fs::remove_all(d);
+}
+
+// A glTF luminaire (.glb, and .gltf with its buffer as a data URI): one write through write_file_atomically.
+TEST(SyscallFaults, GltfLuminaireWritesFailingAnywhereKeepTheOldFile) {
+  for (const bool binary : {true, false}) {
+    const fs::path d = fresh_dir(binary ? "glb" : "gltf");
+    const fs::path target = d / (binary ? "luminaire.glb" : "luminaire.gltf");
+    auto write_luminaire = [&](double albedo) {
+      bake::LuminaireBuilder b("faults");
+      bake::Material m;
+      m.name = "wall";
+      m.base_color = bake::Rgb{albedo};
+      b.begin_part("wall", b.add_material(m));
+      b.sphere(glm::dmat4(1.0), 0.1, 4, 6, 0.0, true);
+      b.point_light({0.0, 0.0, 0.0}, 1.0);
+      bake::GltfWriteOptions o;
+      o.binary = binary;
+      bake::write_gltf_luminaire(b.scene(), target.string(), o);
+    };
+    expect_failed_writes_keep_the_old_file(target, [&] { write_luminaire(0.8); }, [&] { write_luminaire(0.5); }, 97);
+    fs::remove_all(d);
+  }
 }
 
 namespace {
