@@ -165,7 +165,8 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
   const bool fit = GetParam() < 5;
   ResolutionChoice choice;
   const AplErrorReport r =
-      fit ? evaluate_held_out_fitted(*rays, [&](RaySource& train) { return build_apl_set(train, bo); }, eo, &choice)
+      fit ? evaluate_held_out_fitted(*rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo)); },
+                                     eo, &choice)
           : evaluate_held_out(*rays, [&](RaySource& train) { return build_apl_set(train, bo); }, eo);
   const ExactOnSpheres exact = exact_on_spheres(*em, r.reference.spheres, GetParam() % 5 >= 2 ? 8 : 5);  // lobes narrower than a patch: 8 x 8
   std::printf("%s, %llu rays, %s\n", em->name().c_str(), (unsigned long long)rays->info().ray_count,
@@ -232,7 +233,9 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // As lumx build does it: fit on held-out rays, then build from every ray and apply the fit.
   ResolutionChoice choice;
   const auto build = [&](RaySource& r) { return build_apl_set(r, bo); };
-  const AplErrorReport held_out = evaluate_held_out_fitted(*rays, build, eo, &choice);
+  const AplBuildOptions half_bo = half_rays_build_options(bo);
+  const auto build_half = [&](RaySource& r) { return build_apl_set(r, half_bo); };
+  const AplErrorReport held_out = evaluate_held_out_fitted(*rays, build_half, eo, &choice);
   AplSet set = build(*rays);
   const AplLevel built_level0 = set.levels.at(0);
   AplSet as_built = set;  // the resolution rule's maps, unfitted: the default before the held-out fit
@@ -334,8 +337,10 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // The finest level at d ≥ 1, as the sharpened, fitted maps reach it (docs/apl_sets.md): the disk
   // 1.89-1.96 % (the target, 2 %), the rectangle 1.95-2.07 %, the cos^20 spot 1.93-4.32 %, the
   // cos^50 spot 3.0-11.3 % (what 1 M rays allow a lobe of 0.12 sr at single points: see the docs).
-  const double guard[] = {0.02, 0.022, 0.05, 0.125};
-  if (GetParam() <= 3) {
+  // The box with holes: 37.0-41.3 % (49.3-53.1 % when the half set's maps were one step coarser than the
+  // shipped set's, so the fit could not choose the resolution the shipped set is built at).
+  const double guard[] = {0.02, 0.022, 0.05, 0.125, 0.45};
+  {
     for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
       if (ms.relative_distances()[s] >= 1) {
         EXPECT_LT(levels.back()[s], guard[GetParam()]) << ms.relative_distances()[s];

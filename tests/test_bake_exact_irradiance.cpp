@@ -73,7 +73,9 @@ std::vector<double> baked_point_errors(const LuminaireScene& scene, const std::f
   lumx::AplErrorOptions eo;
   lumx::ResolutionChoice choice;
   const auto build = [&](lumx::RaySource& r) { return lumx::build_apl_set(r, bo); };
-  const lumx::AplErrorReport held_out = lumx::evaluate_held_out_fitted(rays, build, eo, &choice);
+  const lumx::AplBuildOptions half = lumx::half_rays_build_options(bo);
+  const auto build_half = [&](lumx::RaySource& r) { return lumx::build_apl_set(r, half); };
+  const lumx::AplErrorReport held_out = lumx::evaluate_held_out_fitted(rays, build_half, eo, &choice);
   lumx::AplSet set = build(rays);
   EXPECT_TRUE(lumx::apply_held_out_fit(set, held_out, &choice));
   const lumx::MeasurementSpheres ms(set.bounds, eo);
@@ -232,10 +234,11 @@ TEST(BakeExactIrradiance, PointLightsInABoxWithHoles) {
     if (radius[s] <= box_reach) continue;
     ++graded;
 #if !defined(__SANITIZE_ADDRESS__)
-    // 1 M particles, 112 000 exits: measured 56.6 and 52.3 % at d = 5 and 10, as the same box from rays
-    // drawn analytically (49-53 %, docs/apl_sets.md); the target, 10 %, is not met: the beams' sharp
-    // borders are blurred by the R 32 maps the fit chooses (docs/bake.md).
-    EXPECT_LT(e[s], 0.62) << "d = " << d[s];
+    // 1 M particles, 112 000 exits: measured 52.2 and 47.1 % at d = 5 and 10 (R 64 maps; 56.6 and 52.3 %
+    // at R 32 when the fit could not choose R 64), as the same box from rays drawn analytically (37-47 %,
+    // docs/apl_sets.md); the target, 10 %, is not met: the beams' sharp borders need a representation of
+    // borders, not a finer density estimate (docs/apl_sets.md, the box study).
+    EXPECT_LT(e[s], 0.56) << "d = " << d[s];
 #endif
     EXPECT_LT(e[s], 1.0) << "d = " << d[s];
   }

@@ -79,8 +79,10 @@ TEST(CliBuild, StoresAndPrintsHeldOutTablesTheLibraryReproduces) {
   bo.threads = 1;
   AplErrorReport report;
   bool fitted = false;
+  const AplBuildOptions half = half_rays_build_options(bo);
   const AplSet set = build_with_held_out_errors(
-      *rays, [&](RaySource& r) { return build_apl_set(r, bo); }, AplErrorOptions{}, &report, &fitted);
+      *rays, [&](RaySource& r) { return build_apl_set(r, half); }, [&](RaySource& r) { return build_apl_set(r, bo); },
+      AplErrorOptions{}, &report, &fitted);
   ASSERT_TRUE(fitted);
   for (std::size_t k = 0; k < 3; ++k) {
     const ErrorTable& stored = reader.manifest().levels[k].error;

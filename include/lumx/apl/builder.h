@@ -119,6 +119,15 @@ inline int map_resolution_for(double rays, double apls, const AplBuildOptions& o
   return std::max(1, std::min(R, o.max_resolution));
 }
 
+/// The options for a set built from half of a rayset's rays (the held-out fit, apl/error.h) whose maps get the
+/// resolutions the rule gives the whole rayset: rays_per_texel halved. The fit only ever coarsens the maps it
+/// is given, so a half set built by the plain rule (one step coarser wherever halving the rays crosses a step:
+/// 112 000 rays give R 64, their 56 000 R 32) could never choose the resolution the shipped set is built at.
+inline AplBuildOptions half_rays_build_options(AplBuildOptions o) {
+  o.rays_per_texel /= 2;
+  return o;
+}
+
 /// Builds an APL set from every ray of `rays` (two passes: seeds, then assignment). Levels that would
 /// repeat the previous level's APL count (fewer seeds than requested) are dropped. Throws
 /// std::invalid_argument for bad options or a rayset without flux.

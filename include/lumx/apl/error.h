@@ -946,14 +946,17 @@ inline bool apply_held_out_fit(AplSet& set, const AplErrorReport& report, const 
 }
 
 /// What `lumx build` ships: `build(rays)` on every ray, each level's maps downsampled to the resolution
-/// fitted on held-out rays (evaluate_held_out_fitted), and the held-out error tables stored in it
-/// (apply_held_out_fit; without tables when half the rays give other levels). `report`, when given,
-/// receives the held-out report; `fitted` whether the fit was applied.
-template <class Build>
-AplSet build_with_held_out_errors(RaySource& rays, Build&& build, const AplErrorOptions& options = {},
-                                  AplErrorReport* report = nullptr, bool* fitted = nullptr) {
+/// fitted on held-out rays (evaluate_held_out_fitted, whose half set `build_half` makes: give it maps at
+/// the resolutions `build` will have, e.g. apl/builder.h's half_rays_build_options, or the fit cannot
+/// choose them), and the held-out error tables stored in it (apply_held_out_fit; without tables when half
+/// the rays give other levels). `report`, when given, receives the held-out report; `fitted` whether the
+/// fit was applied.
+template <class BuildHalf, class Build>
+AplSet build_with_held_out_errors(RaySource& rays, BuildHalf&& build_half, Build&& build,
+                                  const AplErrorOptions& options = {}, AplErrorReport* report = nullptr,
+                                  bool* fitted = nullptr) {
   ResolutionChoice choice;
-  AplErrorReport r = evaluate_held_out_fitted(rays, build, options, &choice);
+  AplErrorReport r = evaluate_held_out_fitted(rays, build_half, options, &choice);
   AplSet set = build(rays);
   const bool applied = apply_held_out_fit(set, r, &choice);
   if (fitted) *fitted = applied;
