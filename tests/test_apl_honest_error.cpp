@@ -330,7 +330,7 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // No level of several APLs is worse than the single far-field point by more than a point (its own
   // noise: the finest level's maps each hold 1/512 of the rays, the far field's all of them). The
   // one-APL level sits at its rays' convergence point instead of the bounding-sphere centre and is
-  // compared in the docs (up to 1.3 % relative worse on the box at d ≤ 0.75).
+  // compared in the docs (up to 0.9 % relative worse on the box at d ≤ 1).
   for (std::size_t s = 0; s < ms.sphere_count(); ++s)
     for (std::size_t k = 1; k < levels.size(); ++k)
       EXPECT_LE(levels[k][s], far[s] + 0.01) << set.levels[k].size() << " APLs, d = " << ms.relative_distances()[s];
