@@ -494,7 +494,7 @@ int run_rays(const EvalArgs& a) {
     std::fprintf(stderr, "%s: note: these rays built the bundle; its levels are rebuilt from the even rays and graded "
                          "on the odd ones\n", a.rays.c_str());
     // As lumx build graded it: resolutions fitted on held-out rays unless the build fixed them.
-    const lumx::AplBuildOptions half = lumx::half_rays_build_options(bo);
+    const lumx::AplBuildOptions half = lumx::half_rays_build_options(bo, rays->info().ray_count);
     const auto build_half = [&](lumx::RaySource& train) { return lumx::build_apl_set(train, half); };
     report = bo.map_resolution > 0 ? lumx::evaluate_held_out(*rays, build_half, o)
                                    : lumx::evaluate_held_out_fitted(*rays, build_half, o);

@@ -530,7 +530,7 @@ AplErrorReport expect_noise_floor_targets(RaySource& rays, double step_tolerance
   AplErrorOptions o;
   o.min_timing_seconds = 0;
   const AplErrorReport r =
-      evaluate_held_out_fitted(rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo)); }, o);
+      evaluate_held_out_fitted(rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo, rays.info().ray_count)); }, o);
   EXPECT_EQ(r.levels.size(), 4u);
   if (r.levels.size() != 4) return r;
   std::printf("%s\n", rays.info().file.c_str());

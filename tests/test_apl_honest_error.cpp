@@ -165,7 +165,7 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
   const bool fit = GetParam() < 5;
   ResolutionChoice choice;
   const AplErrorReport r =
-      fit ? evaluate_held_out_fitted(*rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo)); },
+      fit ? evaluate_held_out_fitted(*rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo, rays->info().ray_count)); },
                                      eo, &choice)
           : evaluate_held_out(*rays, [&](RaySource& train) { return build_apl_set(train, bo); }, eo);
   const ExactOnSpheres exact = exact_on_spheres(*em, r.reference.spheres, GetParam() % 5 >= 2 ? 8 : 5);  // lobes narrower than a patch: 8 x 8
@@ -233,7 +233,7 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // As lumx build does it: fit on held-out rays, then build from every ray and apply the fit.
   ResolutionChoice choice;
   const auto build = [&](RaySource& r) { return build_apl_set(r, bo); };
-  const AplBuildOptions half_bo = half_rays_build_options(bo);
+  const AplBuildOptions half_bo = half_rays_build_options(bo, rays->info().ray_count);
   const auto build_half = [&](RaySource& r) { return build_apl_set(r, half_bo); };
   const AplErrorReport held_out = evaluate_held_out_fitted(*rays, build_half, eo, &choice);
   AplSet set = build(*rays);
@@ -367,6 +367,31 @@ TEST(ResolutionFit, DownsamplingKeepsEveryAplsFluxAndRefusesOtherResolutions) {
     }
   }
   EXPECT_THROW(downsampled_level(set.levels[1], 12), std::invalid_argument);
+}
+
+TEST(ResolutionFit, TheHalfSetGetsTheWholeSetsResolutions) {
+  // The fit only coarsens, so the half set it grades must have the maps the whole set will have: 112 143 rays
+  // give R 64, their even half R 32 by the plain rule. Halving the rays per texel instead is off at the
+  // rule's edges: 65 535 rays (8 per texel: 8 191.9 texels) give R 32, their even half of 32 768 rays R 64.
+  const PlanarEmitter disk = lambertian_disk();
+  for (const std::uint64_t n : {std::uint64_t(65535), std::uint64_t(65536), std::uint64_t(112143)}) {
+    auto rays = disk.source(n, 5);
+    AplBuildOptions bo;
+    bo.level_counts = {1, 8};
+    const AplSet whole = build_apl_set(*rays, bo);
+    RayHalf even(*rays, 0);
+    const AplSet half = build_apl_set(even, half_rays_build_options(bo, n));
+    AplBuildOptions halved = bo;
+    halved.rays_per_texel /= 2;
+    ASSERT_EQ(half.levels.size(), whole.levels.size());
+    for (std::size_t k = 0; k < whole.levels.size(); ++k) {
+      EXPECT_EQ(half.levels[k].map_resolution, whole.levels[k].map_resolution) << n << " rays, level " << k;
+      if (n == 65535) {
+        EXPECT_EQ(whole.levels[k].map_resolution, 32);
+        EXPECT_EQ(map_resolution_for(double(even.info().ray_count), double(whole.levels[k].size()), halved), 64);
+      }
+    }
+  }
 }
 
 TEST(ResolutionFit, FitPatchesFollowTheRays) {

@@ -73,7 +73,7 @@ std::vector<double> baked_point_errors(const LuminaireScene& scene, const std::f
   lumx::AplErrorOptions eo;
   lumx::ResolutionChoice choice;
   const auto build = [&](lumx::RaySource& r) { return lumx::build_apl_set(r, bo); };
-  const lumx::AplBuildOptions half = lumx::half_rays_build_options(bo);
+  const lumx::AplBuildOptions half = lumx::half_rays_build_options(bo, rays.info().ray_count);
   const auto build_half = [&](lumx::RaySource& r) { return lumx::build_apl_set(r, half); };
   const lumx::AplErrorReport held_out = lumx::evaluate_held_out_fitted(rays, build_half, eo, &choice);
   lumx::AplSet set = build(rays);

@@ -79,7 +79,7 @@ TEST(CliBuild, StoresAndPrintsHeldOutTablesTheLibraryReproduces) {
   bo.threads = 1;
   AplErrorReport report;
   bool fitted = false;
-  const AplBuildOptions half = half_rays_build_options(bo);
+  const AplBuildOptions half = half_rays_build_options(bo, rays->info().ray_count);
   const AplSet set = build_with_held_out_errors(
       *rays, [&](RaySource& r) { return build_apl_set(r, half); }, [&](RaySource& r) { return build_apl_set(r, bo); },
       AplErrorOptions{}, &report, &fitted);

@@ -64,6 +64,9 @@ struct AplBuildOptions {
   int map_resolution = 0;           ///< fixed R for every level; 0 = by the rule above
   int min_resolution = 4, max_resolution = 128;
   double rays_per_texel = 8;        ///< the rule's target mean rays per texel
+  /// The ray count the rule counts (0: the rays read). A set built from part of a rayset for the held-out
+  /// fit counts the whole (half_rays_build_options), so that its maps get the whole set's resolutions.
+  std::uint64_t resolution_rays = 0;
   double apl_exponent = 0;          ///< the rule's n^apl_exponent: 0 = the level's rays, 1 = one APL's
   std::size_t chunk_rays = 1 << 16; ///< rays per read
   unsigned threads = 1;             ///< threads for the assignment pass (results do not depend on it)
@@ -119,12 +122,16 @@ inline int map_resolution_for(double rays, double apls, const AplBuildOptions& o
   return std::max(1, std::min(R, o.max_resolution));
 }
 
-/// The options for a set built from half of a rayset's rays (the held-out fit, apl/error.h) whose maps get the
-/// resolutions the rule gives the whole rayset: rays_per_texel halved. The fit only ever coarsens the maps it
-/// is given, so a half set built by the plain rule (one step coarser wherever halving the rays crosses a step:
-/// 112 000 rays give R 64, their 56 000 R 32) could never choose the resolution the shipped set is built at.
-inline AplBuildOptions half_rays_build_options(AplBuildOptions o) {
-  o.rays_per_texel /= 2;
+/// The options for a set built from half of a rayset of `all_rays` rays (the held-out fit, apl/error.h) whose
+/// maps get the resolutions the rule gives the whole rayset: the rule counts `all_rays` (resolution_rays), or,
+/// when that count is unknown (0), half the rays per texel. The fit only ever coarsens the maps it is given,
+/// so a half set built by the plain rule (one step coarser wherever halving the rays crosses a step: 112 000
+/// rays give R 64, their 56 000 R 32) could never choose the resolution the shipped set is built at.
+inline AplBuildOptions half_rays_build_options(AplBuildOptions o, std::uint64_t all_rays) {
+  if (all_rays > 0)
+    o.resolution_rays = all_rays;
+  else
+    o.rays_per_texel /= 2;
   return o;
 }
 
@@ -162,6 +169,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
     while (rays.next(chunk, options.chunk_rays)) total += chunk.size();
   }
   if (total == 0) throw std::invalid_argument("build_apl_set: the rayset has no ray");
+  const double rule_rays = double(options.resolution_rays > 0 ? options.resolution_rays : total);
   const std::uint64_t want = std::min<std::uint64_t>(options.seed_rays, total);
   std::vector<glm::vec3> seed_pos, seed_dir;
   std::vector<float> seed_flux;
@@ -250,7 +258,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
             label[std::size_t(t.right[n])] = label[n];
           }
         const int R = options.map_resolution > 0 ? options.map_resolution
-                                                 : map_resolution_for(double(total), double(c[k].size()), options);
+                                                 : map_resolution_for(rule_rays, double(c[k].size()), options);
         std::vector<LineFit> fit(c[k].size());
         for (std::size_t i = 0; i < seed_pos.size(); ++i)
           if (label[i] >= 0) fit[std::size_t(label[i])].add(seed_pos[i], seed_dir[i], seed_flux[i]);
@@ -345,7 +353,7 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
     AplLevel level;
     level.map_resolution = options.map_resolution > 0
                                ? options.map_resolution
-                               : map_resolution_for(double(total), double(cuts[k].size()), options);
+                               : map_resolution_for(rule_rays, double(cuts[k].size()), options);
     for (std::size_t i = 0; i < cuts[k].size(); ++i) {
       Apl a;
       a.position = tree.center(cuts[k][i]);

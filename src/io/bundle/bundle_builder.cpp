@@ -123,7 +123,7 @@ HeldOutEvaluation evaluate_bundle_levels(RaySource& rays, const BundleBuildOptio
   result.rays = rays.info().ray_count;
   AplErrorOptions eo = o.errors;
   // Maps at the resolutions the whole rayset's set will have (the fit only coarsens).
-  AplBuildOptions half = half_rays_build_options(with_threads(o.apl));
+  AplBuildOptions half = half_rays_build_options(with_threads(o.apl), rays.info().ray_count);
   half.progress = progress_span(o, 0.0, 0.5);
   eo.progress = progress_span(o, 0.5, 1.0);
   const auto build_half = [&](RaySource& train) { return build_apl_set(train, half); };
