@@ -34,7 +34,7 @@ void write_exr_image(const std::string& path, const render::Image& image, bool h
 
 render::Image read_exr_image(const std::string& path, const ImageReadLimits& limits) {
   const std::string bytes = read_file_bounded(path, std::size_t(limits.max_file_bytes));
-  const detail::ExrLayout layout = detail::probe_exr(bytes, path);
+  const detail::ExrLayout layout = detail::probe_exr(bytes, path, limits.max_values);
   const std::uint64_t values =
       std::uint64_t(layout.width) * std::uint64_t(layout.height) * std::uint64_t(layout.channels.size());
   if (layout.width <= 0 || layout.height <= 0 || layout.channels.empty())

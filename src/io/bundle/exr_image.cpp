@@ -73,7 +73,19 @@ class MemoryIStream : public Imf::IStream {
 /// the bytes that follow; fixed-size types must have their size; a channel list, a string vector, a float
 /// vector and a preview image must fill their declared size exactly; ID manifests (compressed) are refused. Single-part
 /// scanline images only. Unknown types are read by OpenEXR as opaque bytes of the declared size.
-void check_exr_header(std::string_view b, const std::string& file) {
+/// The header's dataWindow as read by the walk (x0, y0, x1, y1; `found` false when the header has none).
+struct HeaderWindow {
+  bool found = false;
+  std::int64_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  std::int64_t width() const { return x1 - x0 + 1; }
+  std::int64_t height() const { return y1 - y0 + 1; }
+};
+
+/// Returns the dataWindow, so that callers check the image's size before OpenEXR opens it: OpenEXR sizes its
+/// line buffers by the window as soon as it opens a file (a 223-byte payload declaring 33 554 448 pixels per
+/// line made it allocate 1 GiB for its ZIP buffer, found by fuzz_bundle).
+HeaderWindow check_exr_header(std::string_view b, const std::string& file) {
+  HeaderWindow window;
   const auto u32 = [&](std::size_t at) {
     return std::uint32_t(std::uint8_t(b[at])) | std::uint32_t(std::uint8_t(b[at + 1])) << 8 |
            std::uint32_t(std::uint8_t(b[at + 2])) << 16 | std::uint32_t(std::uint8_t(b[at + 3])) << 24;
@@ -100,7 +112,7 @@ void check_exr_header(std::string_view b, const std::string& file) {
   for (int n = 0;; ++n) {
     if (n > 1024) throw_at_offset(file, std::int64_t(at), "OpenEXR header", "more than 1024 attributes");
     const std::string_view name = zero_terminated(at, b.size(), "attribute name");
-    if (name.empty()) return;
+    if (name.empty()) return window;
     const std::string_view type = zero_terminated(at, b.size(), "attribute type");
     if (b.size() - at < 4) throw_at_offset(file, std::int64_t(at), "OpenEXR header", "ends inside an attribute");
     const std::uint32_t size = u32(at);
@@ -140,6 +152,9 @@ void check_exr_header(std::string_view b, const std::string& file) {
       if (size % 4 != 0) inconsistent("not a whole number of 4-byte floats");
     } else if (type == "idmanifest") {
       throw_at_offset(file, std::int64_t(at), "OpenEXR header", what + ": compressed ID manifests are not read");
+    } else if (name == "dataWindow" && type == "box2i") {  // 16 bytes (checked above): four int32
+      const auto i32 = [&](std::size_t pos) { return std::int64_t(std::int32_t(u32(pos))); };
+      window = {true, i32(value), i32(value + 4), i32(value + 8), i32(value + 12)};
     }
     at = end;
   }
@@ -183,7 +198,12 @@ struct ExrReader::Impl {
 ExrReader::ExrReader(std::string_view bytes, const std::string& file, int width, int height,
                      const std::vector<std::string>& channels)
     : impl_(nullptr), file_(file), width_(width), height_(height), channels_(channels) {
-  check_exr_header(bytes, file);
+  const HeaderWindow declared = check_exr_header(bytes, file);
+  if (declared.found && (declared.x0 != 0 || declared.y0 != 0))
+    fail(file, "dataWindow", "does not start at (0, 0)");
+  if (declared.found && (declared.width() != width || declared.height() != height))
+    fail(file, "dataWindow", "image is " + std::to_string(declared.width()) + " × " + std::to_string(declared.height()) +
+                                 ", the manifest says " + std::to_string(width) + " × " + std::to_string(height));
   try {
     impl_ = new Impl(bytes, file);
     const Imf::Header& header = impl_->file.header();
@@ -235,8 +255,13 @@ void ExrReader::read_rows(int y0, int y1, float* out) {
   }
 }
 
-ExrLayout probe_exr(std::string_view bytes, const std::string& file) {
-  check_exr_header(bytes, file);
+ExrLayout probe_exr(std::string_view bytes, const std::string& file, std::uint64_t max_pixels) {
+  const HeaderWindow declared = check_exr_header(bytes, file);
+  if (declared.found && (declared.width() <= 0 || declared.height() <= 0 ||
+                         std::uint64_t(declared.width()) * std::uint64_t(declared.height()) > max_pixels))
+    fail(file, "dataWindow", std::to_string(declared.width()) + " × " + std::to_string(declared.height()) +
+                                 " pixels: none, or more than ImageReadLimits::max_values (" +
+                                 std::to_string(max_pixels) + ")");
   try {
     MemoryIStream stream(bytes, file);
     Imf::InputFile input(stream);

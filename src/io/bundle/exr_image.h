@@ -8,6 +8,7 @@
 
 #include <lumx/version.h>
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -56,13 +57,14 @@ class ExrReader {
 
 /// Size and channel names of an OpenEXR image in memory, from its header alone (nothing is decoded, so the
 /// caller can check them against its limits before allocating). Channels are in the file's (alphabetical)
-/// order. Throws lumx::Error naming `file`.
+/// order. Throws lumx::Error naming `file`, also for a data window of no pixels or more than `max_pixels`
+/// (checked before OpenEXR opens the image, which sizes its line buffers by it).
 struct ExrLayout {
   int width = 0;
   int height = 0;
   std::vector<std::string> channels;
 };
-ExrLayout probe_exr(std::string_view bytes, const std::string& file);
+ExrLayout probe_exr(std::string_view bytes, const std::string& file, std::uint64_t max_pixels);
 
 /// Decodes a whole image (for small payloads such as the radiance volume).
 ExrImage decode_exr(std::string_view bytes, const std::string& file, int width, int height,
