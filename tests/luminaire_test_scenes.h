@@ -185,4 +185,21 @@ inline std::filesystem::path write_sphere_luminaire(const std::filesystem::path&
   return path;
 }
 
+/// A white closed sphere (r = 10 cm, `rings` × `sectors`, smooth normals) around a point light, written to
+/// `path` as .glb (`binary`) or .gltf with its buffer as a data URI; `albedo` tells two versions apart (the
+/// writers' failure and kill tests).
+inline void write_white_sphere_luminaire(const std::filesystem::path& path, int rings, int sectors, double albedo,
+                                         bool binary) {
+  SceneBuilder b("white sphere");
+  Material m;
+  m.name = "wall";
+  m.base_color = Rgb{albedo};
+  b.begin_part("wall", b.add_material(m));
+  b.sphere(glm::dmat4(1.0), 0.1, rings, sectors, 0.0, true);
+  b.point_light({0.0, 0.0, 0.0}, 1.0);
+  lumx::bake::GltfWriteOptions o;
+  o.binary = binary;
+  lumx::bake::write_gltf_luminaire(b.scene(), path.string(), o);
+}
+
 }  // namespace lumx_test

@@ -4,13 +4,12 @@
 // JSON, TM-25, glTF luminaires as .glb and .gltf) and is killed while its temporary exists. The target must then hold one whole version,
 // byte for byte, and the next write of the same target must leave no temporary behind
 // (docs/robustness.md §4; hard-cases.md §6 item 36).
-#include <lumx/bake/gltf_writer.h>
-#include <lumx/bake/luminaire_builder.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/io/rayset_io.h>
 
 #include <gtest/gtest.h>
 
+#include "luminaire_test_scenes.h"
 #include "test_support.h"
 
 #include <chrono>
@@ -154,19 +153,9 @@ TEST(Robustness, KilledTm25WriteLeavesAWholeFileAndNoTemporaryAfterTheNextWrite)
 
 namespace {
 
-/// A luminaire of 47 600 triangles (a white sphere of 120 rings × 200 sectors, smooth normals) as glTF,
-/// binary or with its buffer as a data URI: 4.0 MB as .glb, 5.3 MB as .gltf. `albedo` makes a second version.
+/// A luminaire of 47 600 triangles (120 rings × 200 sectors) as glTF: 4.0 MB as .glb, 5.3 MB as .gltf.
 void write_sphere_luminaire(const fs::path& target, double albedo, bool binary) {
-  bake::LuminaireBuilder b("kill");
-  bake::Material m;
-  m.name = "wall";
-  m.base_color = bake::Rgb{albedo};
-  b.begin_part("wall", b.add_material(m));
-  b.sphere(glm::dmat4(1.0), 0.1, 120, 200, 0.0, true);
-  b.point_light({0.0, 0.0, 0.0}, 1.0);
-  bake::GltfWriteOptions o;
-  o.binary = binary;
-  bake::write_gltf_luminaire(b.scene(), target.string(), o);
+  lumx_test::write_white_sphere_luminaire(target, 120, 200, albedo, binary);
 }
 
 }  // namespace

@@ -6,8 +6,6 @@
 // the previous file (or bundle) byte for byte, and leave no temporary behind. A crash at that moment would
 // leave the same state, with at most a temporary that the next write removes (tests/test_killed_writes.cpp).
 #include <lumx/apl/apl_set.h>
-#include <lumx/bake/gltf_writer.h>
-#include <lumx/bake/luminaire_builder.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/image_io.h>
 #include <lumx/io/photometry_io.h>
@@ -17,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "syscall_faults.h"
+#include "luminaire_test_scenes.h"
 #include "test_support.h"
 
 #include <cerrno>
@@ -202,18 +201,7 @@ TEST(SyscallFaults, GltfLuminaireWritesFailingAnywhereKeepTheOldFile) {
   for (const bool binary : {true, false}) {
     const fs::path d = fresh_dir(binary ? "glb" : "gltf");
     const fs::path target = d / (binary ? "luminaire.glb" : "luminaire.gltf");
-    auto write_luminaire = [&](double albedo) {
-      bake::LuminaireBuilder b("faults");
-      bake::Material m;
-      m.name = "wall";
-      m.base_color = bake::Rgb{albedo};
-      b.begin_part("wall", b.add_material(m));
-      b.sphere(glm::dmat4(1.0), 0.1, 4, 6, 0.0, true);
-      b.point_light({0.0, 0.0, 0.0}, 1.0);
-      bake::GltfWriteOptions o;
-      o.binary = binary;
-      bake::write_gltf_luminaire(b.scene(), target.string(), o);
-    };
+    auto write_luminaire = [&](double albedo) { lumx_test::write_white_sphere_luminaire(target, 4, 6, albedo, binary); };
     expect_failed_writes_keep_the_old_file(target, [&] { write_luminaire(0.8); }, [&] { write_luminaire(0.5); }, 97);
     fs::remove_all(d);
   }
