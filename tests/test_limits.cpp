@@ -111,6 +111,8 @@ Bounded run_bounded(const std::function<void()>& read, long address_space_mb = 0
       const struct rlimit rl {limit, limit};
       ::setrlimit(RLIMIT_AS, &rl);
     }
+#else
+    (void)address_space_mb;
 #endif
     struct rusage ru {};
     ::getrusage(RUSAGE_SELF, &ru);
