@@ -89,10 +89,11 @@ void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lu
     for (std::size_t k = 0; k < r.resolution.size(); ++k) {
       std::printf(" %d", r.resolution[k]);
       const std::vector<double>& kappa = r.held_out.choice.kappa;
-      const std::vector<bool>& sharpened = r.held_out.choice.sharpened;
+      const std::vector<lumx::KernelMode>& mode = r.held_out.choice.mode;
+      const lumx::KernelMode m = k < mode.size() ? mode[k] : lumx::KernelMode::plain;
       if (k < kappa.size() && kappa[k] > 0)
-        std::printf(" (kernel σ %.1f°%s)", 180.0 / lumx::kPi / std::sqrt(kappa[k]),
-                    k < sharpened.size() && sharpened[k] ? ", sharpened" : "");
+        std::printf(" (kernel σ %.1f°%s%s)", 180.0 / lumx::kPi / std::sqrt(kappa[k]),
+                    m == lumx::KernelMode::plain ? "" : ", ", lumx::kernel_mode_name(m));
     }
     std::printf(" (levels 0..%zu)\n", r.resolution.size() - 1);
   }
@@ -104,7 +105,9 @@ void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lu
                 r.far_field_resolution,
                 r.far_field_kernel_sigma_deg > 0
                     ? (", kernel σ " + std::to_string(r.far_field_kernel_sigma_deg).substr(0, 4) + "°" +
-                       (r.far_field_kernel_sharpened ? ", sharpened" : ""))
+                       (r.far_field_kernel_mode == lumx::KernelMode::plain
+                            ? std::string()
+                            : std::string(", ") + lumx::kernel_mode_name(r.far_field_kernel_mode)))
                           .c_str()
                     : "");
   std::printf("bundle:   %s, %llu bytes; evaluation %.2f s, far field %.2f s, writing %.2f s; %.2f s in all\n",

@@ -161,6 +161,7 @@ class PinholeBox : public AnalyticEmitter {
   PinholeBox(std::string name, double half, std::vector<Hole> holes, std::vector<Source> sources)
       : name_(std::move(name)), h_(half), holes_(std::move(holes)), sources_(std::move(sources)) {}
   std::string name() const override { return name_; }
+  const std::vector<Hole>& holes() const { return holes_; }
 
   lumx::RayChunk rays(std::uint64_t n, std::uint64_t seed) const override {
     lumx::RayChunk c;

@@ -13,7 +13,9 @@
 
 #include "analytic_emitters.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <cstdlib>
 #include <memory>
 
@@ -261,9 +263,9 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
     levels.push_back(row_errors([&](const glm::vec3& x, const glm::vec3& n) {
       return luminance_of(set.channels, irradiance(set, k, x, n).irradiance);
     }));
-    std::printf("  %4zu APLs R %3d σ %4.1f°%s:", set.levels[k].size(), set.levels[k].map_resolution,
+    std::printf("  %4zu APLs R %3d σ %4.1f° %s:", set.levels[k].size(), set.levels[k].map_resolution,
                 choice.kappa.at(k) > 0 ? 180.0 / kPi / std::sqrt(choice.kappa.at(k)) : 0.0,
-                choice.sharpened.at(k) ? " sharpened" : "");
+                kernel_mode_name(choice.mode.at(k)));
     for (double e : levels.back()) std::printf(" %6.2f", 100 * e);
     std::printf("\n");
   }
@@ -273,12 +275,13 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   std::printf("\n");
   // The far field attached as IES: level 0's fitted maps on the Type C grid against the rays binned on
   // that grid (2.5° × 1°), as irradiance at the d ≥ 2 points from the bounding-sphere centre.
+  std::vector<double> ies_level0;
   {
     AplSet far_set = set;
     far_set.levels[0] = fitted_level(built_level0, choice.far_field_resolution, choice.far_field_kappa,
-                                     choice.far_field_sharpened);
-    std::printf("  far field maps fitted at d = 5, 10: R %d, kernel κ %.0f%s\n", choice.far_field_resolution,
-                choice.far_field_kappa, choice.far_field_sharpened ? " sharpened" : "");
+                                     choice.far_field_mode);
+    std::printf("  far field maps fitted at d = 5, 10: R %d, kernel κ %.0f %s\n", choice.far_field_resolution,
+                choice.far_field_kappa, kernel_mode_name(choice.far_field_mode));
     const Photometry from_map = far_field_photometry(far_set, 0), from_rays = far_field_from_rays(*rays);
     const IntensityTable tm(from_map), tr(from_rays);
     const auto ies_row = [&](const IntensityTable& t) {
@@ -290,6 +293,7 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
       });
     };
     const std::vector<double> e_map = ies_row(tm), e_rays = ies_row(tr);
+    ies_level0 = e_map;
     std::printf("  IES, level 0  :");
     for (double e : e_map) std::printf(" %6.2f", 100 * e);
     std::printf("\n  IES, rays     :");
@@ -334,17 +338,28 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   for (std::size_t s = 0; s < ms.sphere_count(); ++s)
     for (std::size_t k = 1; k < levels.size(); ++k)
       EXPECT_LE(levels[k][s], far[s] + 0.01) << set.levels[k].size() << " APLs, d = " << ms.relative_distances()[s];
-  // The finest level at d ≥ 1, as the sharpened, fitted maps reach it (docs/apl_sets.md): the disk
-  // 1.89-1.96 % (the target, 2 %), the rectangle 1.95-2.07 %, the cos^20 spot 1.93-4.32 %, the
+  // The finest level at d ≥ 1, as the fitted maps reach it (docs/apl_sets.md): the disk 0.90-1.00 % and
+  // the rectangle 1.80-1.87 % (local linear kernels; sharpened, which leak light across the emitters'
+  // horizon, 1.89-1.96 and 1.95-2.07 %; the target is 2 %), the cos^20 spot 1.93-4.32 %, the
   // cos^50 spot 3.0-11.3 % (what 1 M rays allow a lobe of 0.12 sr at single points: see the docs).
   // The box with holes: 37.0-41.3 % (49.3-53.1 % when the half set's maps were one step coarser than the
-  // shipped set's, so the fit could not choose the resolution the shipped set is built at).
-  const double guard[] = {0.02, 0.022, 0.05, 0.125, 0.45};
-  {
-    for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
-      if (ms.relative_distances()[s] >= 1) {
-        EXPECT_LT(levels.back()[s], guard[GetParam()]) << ms.relative_distances()[s];
-      }
+  // shipped set's, so the fit could not choose the resolution the shipped set is built at); exact maps at
+  // R 64 are 33-36 % off there (PinholeBoxStudy.DISABLED_ExactBeamsAtTheSourcesBoundWhatMapsCanDo).
+  const double guard[] = {0.0125, 0.02, 0.05, 0.125, 0.45};
+  for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
+    const double d = ms.relative_distances()[s];
+    if (d >= 1) {
+      EXPECT_LT(levels.back()[s], guard[GetParam()]) << d;
+    }
+    // The targets for the Lambertian emitters: ≤ 5 % at d = 0.5 (1.05 and 1.84 % measured); the
+    // far field, as the one-APL level (1.85/1.91 and 1.97/1.88 %) and as the attached IES (1.03/0.98 and
+    // 1.42/1.10 %; sharpened 2.05/2.02 and 2.33/2.13 %), ≤ 2 % at d ≥ 5.
+    if (GetParam() <= 1 && d == 0.5) {
+      EXPECT_LE(levels.back()[s], 0.05);
+    }
+    if (GetParam() <= 1 && d >= 5) {
+      EXPECT_LE(levels.front()[s], 0.02) << "one APL, d = " << d;
+      EXPECT_LE(ies_level0[s], 0.02) << "IES, d = " << d;
     }
   }
 }
@@ -456,6 +471,202 @@ TEST(PinholeBoxStudy, DISABLED_BordersNotRaysLimitTheFinestLevel) {
       if (n == 1000000 && R == 64) break;  // coarser rays: R 64 is what the rule gives them
     }
     ++n_index;
+  }
+}
+}  // namespace
+
+namespace {
+// The representation's own floor on the box with holes: two APLs placed exactly at the two sources, each
+// map the exact intensity of its source averaged over every texel (4 × 4 equal-area sub-directions per
+// texel; no rays, so no noise), read as a renderer reads it (bilinear). Whatever a builder does with rays,
+// a map at resolution R cannot beat this row. Printed, and checked against docs/apl_sets.md.
+// Off by default (about 30 s):
+//   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*ExactBeams*'
+TEST(PinholeBoxStudy, DISABLED_ExactBeamsAtTheSourcesBoundWhatMapsCanDo) {
+  const PinholeBox box = pinhole_box();
+  const std::unique_ptr<AnalyticEmitter> em = suite_emitter(4);
+  const AplErrorOptions eo;
+  // The measurement spheres of the set the builder makes from the suite's rays (the same bounds).
+  AplBuildOptions bo;
+  bo.threads = 2;
+  bo.level_counts = {2};
+  const AplSet built = build_apl_set(*em->source(kSuiteRays, 15), bo);
+  const MeasurementSpheres ms(built.bounds, eo);
+  const ExactOnSpheres exact = exact_on_spheres(*em, ms, 1);
+  const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);
+  const std::vector<PinholeBox::Source> sources = {{{-0.02, 0.01, 0.0}, 500}, {{0.015, -0.01, 0.01}, 500}};
+  // docs/apl_sets.md, d = 0.5 … 10, %: bilinear at R 64 … 1024, then nearest texel at R 1024.
+  const double documented[6][6] = {{40.96, 42.09, 33.00, 35.92, 32.63, 34.96}, {29.88, 29.05, 20.97, 23.33, 23.45, 23.71},
+                                   {22.90, 22.28, 15.16, 16.17, 18.51, 14.59}, {15.57, 19.16, 11.26, 10.39, 17.28, 11.74},
+                                   {11.47, 14.57, 3.54, 10.78, 16.34, 8.99},   {14.76, 7.09, 0.94, 9.50, 16.35, 0.00}};
+  int row = 0;
+  for (const int R : {64, 128, 256, 512, 1024}) {
+    AplSet set;
+    set.bounds = built.bounds;
+    set.levels.resize(1);
+    set.levels[0].map_resolution = R;
+    for (const PinholeBox::Source& s : sources) {
+      // One source alone behind the same holes: visible in w iff its far irradiance along w is non-zero.
+      const PinholeBox one("one source", 0.05, box.holes(), {s});
+      Apl a;
+      a.position = glm::vec3(s.p);
+      a.map = SphereMap(R, 1);
+      constexpr int kSub = 4;
+      for (int y = 0; y < R; ++y)
+        for (int x = 0; x < 2 * R; ++x) {
+          int lit = 0;
+          for (int j = 0; j < kSub; ++j)
+            for (int i = 0; i < kSub; ++i) {
+              const glm::vec2 uv((float(x) + (float(i) + 0.5f) / kSub) / float(2 * R),
+                                 (float(y) + (float(j) + 0.5f) / kSub) / float(R));
+              const glm::dvec3 w = glm::normalize(glm::dvec3(sphere_map::uv_to_direction(uv)));
+              lit += one.irradiance(s.p + 100.0 * w, -w) > 0;
+            }
+          a.map.at(x, y, 0) = float(s.flux / (4 * kPi) * lit / (kSub * kSub));
+        }
+      a.flux = a.map.integral();
+      set.levels[0].apls.push_back(std::move(a));
+    }
+    std::printf("exact beams at the sources, R %4d:", R);
+    for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
+      std::vector<double> model(dirs.size());
+      for (std::size_t p = 0; p < dirs.size(); ++p)
+        model[p] = luminance_of(set.channels, irradiance(set, 0, glm::vec3(ms.centre() + ms.radius(s) * dirs[p]),
+                                                         glm::vec3(-dirs[p])).irradiance);
+      const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
+      std::printf(" %6.2f", e);
+      EXPECT_NEAR(e, documented[row][s], 0.01) << "R " << R << ", sphere " << s;
+      // How few points carry the error: the fewest whose squared errors make 90 % of the sum; and the
+      // lit points' mean irradiance over the sphere's mean.
+      std::vector<double> sq(dirs.size());
+      double total = 0, lit_sum = 0, all_sum = 0;
+      std::size_t lit = 0;
+      for (std::size_t p = 0; p < dirs.size(); ++p) {
+        sq[p] = (model[p] - exact.at_centre[s][p]) * (model[p] - exact.at_centre[s][p]);
+        total += sq[p];
+        all_sum += exact.at_centre[s][p];
+        if (exact.at_centre[s][p] > 0) lit_sum += exact.at_centre[s][p], ++lit;
+      }
+      std::sort(sq.begin(), sq.end(), std::greater<double>());
+      std::size_t carriers = 0;
+      for (double acc = 0; carriers < sq.size() && acc < 0.9 * total; ++carriers) acc += sq[carriers];
+      std::printf(" [%zu pts, lit %zu, %.1f×]", carriers, lit, (lit_sum / double(lit)) / (all_sum / double(dirs.size())));
+    }
+    std::printf("   (%zu points per sphere)\n", dirs.size());
+    // The same maps read at the nearest texel (a staircase border instead of a one-texel ramp).
+    std::printf("                 nearest texel:");
+    for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
+      std::vector<double> model(dirs.size(), 0.0);
+      for (std::size_t p = 0; p < dirs.size(); ++p) {
+        const glm::dvec3 x = ms.centre() + ms.radius(s) * dirs[p];
+        for (const Apl& a : set.levels[0].apls) {
+          const glm::dvec3 d = x - glm::dvec3(a.position);
+          const double r = glm::length(d);
+          const glm::dvec3 w = d / r;
+          const double cosine = glm::dot(dirs[p], w);
+          if (cosine > 0) model[p] += a.map.lookup_nearest(glm::vec3(w)).x * cosine / (r * r);
+        }
+      }
+      const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
+      std::printf(" %6.2f", e);
+      if (R == 1024) {
+        EXPECT_NEAR(e, documented[5][s], 0.01) << "nearest texel, sphere " << s;
+      }
+    }
+    std::printf("\n");
+    ++row;
+  }
+}
+}  // namespace
+
+namespace {
+// The IES far field of the Lambertian emitters (docs/apl_sets.md): level 0's maps at R 64 and each kernel
+// against the exact irradiance at d = 2, 5, 10 from the bounding-sphere centre, beside the floor of a point
+// at that centre with the exact intensity (I(ω) = r² E(c + r ω) at r = 10⁴ m), and the share of the
+// squared error at d = 10 within 15° of the emitters' horizon (z = 0; they emit into z > 0). Printed, and
+// checked against the documented rows. Off by default (about 15 s):
+//   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*WiderKernels*'
+TEST(FarFieldStudy, DISABLED_WiderKernelsForTheLambertianFarField) {
+  // Per emitter: the floor, then R 64 with σ = 0, 3.4 (plain), 6.7 (sharpened), 13.5 (plain), 13.5° (sharpened):
+  // d = 5 and 10, %.
+  // Then local linear at σ 6.7°.
+  const double documented[2][7][2] = {
+      {{0.46, 0.11}, {5.44, 5.48}, {2.21, 2.22}, {2.05, 2.02}, {13.24, 13.35}, {5.50, 5.49}, {1.03, 0.98}},
+      {{0.89, 0.22}, {4.78, 4.72}, {2.44, 2.31}, {2.33, 2.13}, {13.12, 13.25}, {5.52, 5.46}, {1.42, 1.10}}};
+  for (int which : {0, 1}) {
+    const std::unique_ptr<AnalyticEmitter> em = suite_emitter(which);
+    auto rays = em->source(kSuiteRays, 11 + std::uint64_t(which));
+    AplBuildOptions bo;
+    bo.threads = 2;
+    const AplSet set = build_apl_set(*rays, bo);
+    AplErrorOptions eo;
+    eo.relative_distances = {2, 5, 10};
+    const MeasurementSpheres ms(set.bounds, eo);
+    const ExactOnSpheres exact = exact_on_spheres(*em, ms, 1);
+    const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);
+    const double near_horizon = std::sin(15.0 * kDegToRad);
+    double horizon_share = 0;
+    const auto ies_errors = [&](auto&& intensity) {
+      std::vector<double> out;
+      for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
+        std::vector<double> model(dirs.size());
+        double all = 0, band = 0;
+        for (std::size_t p = 0; p < dirs.size(); ++p) {
+          const glm::dvec3 x = ms.centre() + ms.radius(s) * dirs[p];
+          const glm::dvec3 d = x - set.bounds.center;
+          const double r = glm::length(d);
+          const glm::dvec3 w = d / r;
+          model[p] = intensity(w) * std::max(0.0, glm::dot(dirs[p], w)) / (r * r);
+          const double sq = (model[p] - exact.at_centre[s][p]) * (model[p] - exact.at_centre[s][p]);
+          all += sq;
+          if (std::abs(w.z) < near_horizon) band += sq;
+        }
+        horizon_share = all > 0 ? band / all : 0;
+        out.push_back(100 * compare_irradiance(exact.at_centre[s], model).relative_rmse);
+      }
+      return out;
+    };
+    std::printf("%s (level 0: %zu APLs, R %d), d = 2, 5, 10\n", em->name().c_str(), set.levels[0].size(),
+                set.levels[0].map_resolution);
+    const std::vector<double> floor = ies_errors([&](const glm::dvec3& w) {
+      const double r = 1e4;
+      return r * r * em->irradiance(set.bounds.center + r * w, -w);
+    });
+    std::printf("  exact intensity at the centre : %6.2f %6.2f %6.2f\n", floor[0], floor[1], floor[2]);
+    EXPECT_NEAR(floor[1], documented[which][0][0], 0.01);
+    EXPECT_NEAR(floor[2], documented[which][0][1], 0.01);
+    const int R = 64;
+    const double texel = std::sqrt(4.0 * kPi / (2.0 * double(R) * double(R)));
+    const std::pair<double, bool> kernels[] = {{0.0, false}, {1.5, false}, {3.0, true}, {6.0, false}, {6.0, true}};
+    int row = 1;
+    for (const auto& [widths, sharpened] : kernels) {
+      const double kappa = widths > 0 ? 1.0 / ((widths * texel) * (widths * texel)) : 0.0;
+      AplSet far_set = set;
+      far_set.levels.resize(1);
+      far_set.levels[0] = fitted_level(set.levels[0], R, kappa, sharpened ? KernelMode::sharpened : KernelMode::plain);
+      const IntensityTable t(far_field_photometry(far_set, 0));
+      const std::vector<double> e = ies_errors([&](const glm::dvec3& w) { return t.intensity(w); });
+      std::printf("  R %2d σ %5.1f°%s: %6.2f %6.2f %6.2f   (%2.0f %% of the squared error at d = 10 within 15° of the horizon)\n",
+                  R, widths * texel * 180 / kPi, sharpened ? " sharpened" : "          ", e[0], e[1], e[2], 100 * horizon_share);
+      EXPECT_NEAR(e[1], documented[which][row][0], 0.01) << row;
+      EXPECT_NEAR(e[2], documented[which][row][1], 0.01) << row;
+      ++row;
+    }
+    // Local linear (SphereMapKernel::local_linear_gain): no leak across the horizon.
+    for (const double widths : {1.5, 3.0, 4.5}) {
+      const double kappa = 1.0 / ((widths * texel) * (widths * texel));
+      AplSet far_set = set;
+      far_set.levels.resize(1);
+      far_set.levels[0] = fitted_level(set.levels[0], R, kappa, KernelMode::local_linear);
+      const IntensityTable t(far_field_photometry(far_set, 0));
+      const std::vector<double> e = ies_errors([&](const glm::dvec3& w) { return t.intensity(w); });
+      std::printf("  R %2d σ %5.1f° local linear: %6.2f %6.2f %6.2f   (%2.0f %% within 15° of the horizon)\n", R,
+                  widths * texel * 180 / kPi, e[0], e[1], e[2], 100 * horizon_share);
+      if (widths == 3.0) {
+        EXPECT_NEAR(e[1], documented[which][6][0], 0.01);
+        EXPECT_NEAR(e[2], documented[which][6][1], 0.01);
+      }
+    }
   }
 }
 }  // namespace

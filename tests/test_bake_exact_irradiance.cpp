@@ -123,11 +123,12 @@ TEST(BakeExactIrradiance, LambertianDisk) {
   EXPECT_NEAR(exit_flux, flux, 1e-5 * flux);  // every particle leaves the bare disk: exact up to float sums
   for (std::size_t s = 0; s < d.size(); ++s) {
 #if !defined(__SANITIZE_ADDRESS__)
-    // 1 M particles, 512 APLs: measured 1.89-2.00 % at d ≥ 1 at the rotated patches' centres (R 64 maps,
-    // the fitted σ 6.7° kernel sharpened), as for 1 M rays drawn from the analytic disk (1.89-1.96 %,
-    // docs/apl_sets.md); the target is 3 %.
+    // 1 M particles, 512 APLs: measured 0.97-0.98 % at d ≥ 1 at the rotated patches' centres (R 64 maps,
+    // the fitted σ 6.7° kernel, local linear), as for 1 M rays drawn from the analytic disk (0.90-1.00 %,
+    // docs/apl_sets.md); the target is 3 %. The sharpened kernel, which leaks light across the disk's
+    // horizon, gave 1.89-2.00 %: the guard is 1.5 %.
     if (d[s] >= 1) {
-      EXPECT_LT(e[s], 0.03) << "d = " << d[s];
+      EXPECT_LT(e[s], 0.015) << "d = " << d[s];
     }
 #endif
     EXPECT_LT(e[s], 0.25) << "d = " << d[s];
@@ -193,9 +194,10 @@ TEST(BakeExactIrradiance, IntegratingSphere) {
   for (std::size_t s = 0; s < d.size(); ++s) {
     if (d[s] < 1) continue;  // spheres of d < 1 cut through the luminaire, whose wall the formula ignores
 #if !defined(__SANITIZE_ADDRESS__)
-    // 4 M particles, 1.1 M exits: measured 2.70, 2.46, 2.32, 2.30 % at d = 1, 2, 5, 10 (R 64, sharpened
-    // kernel); the target is 3 %. (1 M particles, 279 000 exits: 4.2-5.2 % with R 32 maps.)
-    EXPECT_LT(e[s], 0.03) << "d = " << d[s];
+    // 4 M particles, 1.1 M exits: measured 1.54, 1.30, 1.20, 1.24 % at d = 1, 2, 5, 10 (R 64, local
+    // linear kernel); the target is 3 %. (Sharpened: 2.70-2.30 %; 1 M particles, 279 000 exits: 4.2-5.2 %
+    // with R 32 maps.) The guard is 2 %.
+    EXPECT_LT(e[s], 0.02) << "d = " << d[s];
 #endif
     EXPECT_LT(e[s], 0.25) << "d = " << d[s];
   }

@@ -624,27 +624,26 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
 // and might afford one step finer — the choice is the conservative one.
 
 /// One candidate of the fit: maps at `resolution`, smoothed by the von Mises–Fisher kernel of
-/// concentration `kappa` (1/rad²; 0: not smoothed), sharpened when `sharpened` (SphereMapKernel::
-/// apply_sharpened), and its Σ_d log ε(d).
+/// concentration `kappa` (1/rad²; 0: not smoothed) in `mode` (KernelMode), and its Σ_d log ε(d).
 struct FitCandidate {
   int resolution = 0;
   double kappa = 0;
   double cost = 0;
-  bool sharpened = false;
+  KernelMode mode = KernelMode::plain;
 };
 
 /// Per level, the chosen resolution and kernel and every candidate tried (finest first).
 struct ResolutionChoice {
   std::vector<int> resolution;                        ///< per level
   std::vector<double> kappa;                          ///< per level: the kernel's κ (0: none)
-  std::vector<bool> sharpened;                        ///< per level: the kernel is sharpened (sharpening_gain)
+  std::vector<KernelMode> mode;                       ///< per level: how the kernel smooths
   std::vector<std::vector<FitCandidate>> tried;       ///< per level
   /// The resolution of level 0's maps for the far field alone (IES/EULUMDAT export), fitted at d = 5 and
   /// 10 on patches of R 64 (3° wide): a far field needs angular detail the near field's compromise can
   /// give away (evaluate_held_out_fitted). 0 when not fitted.
   int far_field_resolution = 0;
   double far_field_kappa = 0;  ///< and its kernel (0: none)
-  bool far_field_sharpened = false;  ///< and sharpened
+  KernelMode far_field_mode = KernelMode::plain;  ///< and how it smooths
 };
 
 /// The patch resolution fit_map_resolutions grades on in evaluate_held_out_fitted, for `rays` fitting rays
@@ -670,29 +669,31 @@ inline AplLevel downsampled_level(const AplLevel& level, int R) {
   return out;
 }
 
-/// The level's maps smoothed by `kernel` (whose resolution must be theirs; sharpened when `sharpened`), on up
-/// to `threads` threads (0: the hardware's); each map is smoothed alone, so the result does not depend on
-/// the thread count.
+/// The level's maps smoothed by `kernel` (whose resolution must be theirs) in `mode`, on up to `threads`
+/// threads (0: the hardware's); each map is smoothed alone, so the result does not depend on the thread
+/// count.
 inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& kernel, unsigned threads = 0,
-                               bool sharpened = false) {
+                               KernelMode mode = KernelMode::plain) {
   AplLevel out = level;
   const std::size_t n = out.apls.size();
   if (threads == 0) threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   threads = unsigned(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 8)));
-  // Sharpened: one gain from the level's sum (its far field) for every map (SphereMapKernel::apply_with_gain).
+  // Sharpened or local linear: one gain from the level's sum (its far field) for every map
+  // (SphereMapKernel::apply_with_gain), so the sparse maps sum to the sum's estimate.
+  const bool with_gain = mode != KernelMode::plain;
   SphereMap gain;
-  if (sharpened && n > 0) {
+  if (with_gain && n > 0) {
     SphereMap total(kernel.resolution(), 1);
     for (const Apl& a : level.apls) {
       const int C = a.map.channels();
       for (std::size_t t = 0; t < total.texel_count(); ++t)
         for (int c = 0; c < C; ++c) total.data()[t] += a.map.data()[t * std::size_t(C) + std::size_t(c)];
     }
-    gain = kernel.sharpening_gain(total);
+    gain = kernel.gain(total, mode);
   }
   const auto run = [&](std::size_t from, std::size_t to) {
     for (std::size_t i = from; i < to; ++i)
-      out.apls[i].map = sharpened ? kernel.apply_with_gain(level.apls[i].map, gain) : kernel.apply(level.apls[i].map);
+      out.apls[i].map = with_gain ? kernel.apply_with_gain(level.apls[i].map, gain) : kernel.apply(level.apls[i].map);
   };
   if (threads <= 1) {
     run(0, n);
@@ -704,11 +705,10 @@ inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& ker
   return out;
 }
 
-/// The fitted maps of a level: downsampled to R, then smoothed by the kernel of κ when κ > 0 (sharpened when
-/// `sharpened`).
-inline AplLevel fitted_level(const AplLevel& level, int R, double kappa, bool sharpened = false) {
+/// The fitted maps of a level: downsampled to R, then smoothed by the kernel of κ in `mode` when κ > 0.
+inline AplLevel fitted_level(const AplLevel& level, int R, double kappa, KernelMode mode = KernelMode::plain) {
   AplLevel out = downsampled_level(level, R);
-  if (kappa > 0) out = smoothed_level(out, *SphereMapKernel::shared(R, kappa), 0, sharpened);
+  if (kappa > 0) out = smoothed_level(out, *SphereMapKernel::shared(R, kappa), 0, mode);
   return out;
 }
 
@@ -723,21 +723,25 @@ inline std::vector<double> fit_kernel_kappas(int R) {
   return out;
 }
 
-/// A kernel the fit tries: κ (1/rad²) and whether it is sharpened.
+/// A kernel the fit tries: κ (1/rad²) and how it smooths.
 struct FitKernel {
   double kappa = 0;
-  bool sharpened = false;
+  KernelMode mode = KernelMode::plain;
 };
 
-/// The kernels the fit tries at resolution R: fit_kernel_kappas(R) as they are, and sharpened
-/// (SphereMapKernel::sharpening_gain: bias O(κ⁻²), so a spot's lobe keeps its peak) at σ = 1.5 and 3
-/// texel widths.
+/// The kernels the fit tries at resolution R: fit_kernel_kappas(R) as they are; sharpened
+/// (SphereMapKernel::sharpening_gain: bias O(κ⁻²), so a spot's lobe keeps its peak) at σ = 0.75, 1.5 and 3
+/// texel widths; and local linear (SphereMapKernel::local_linear_gain: no leak across the border of the
+/// rays' support, such as a Lambertian emitter's horizon, where the others put most of their error) at
+/// σ = 1.5 and 3 texel widths.
 inline std::vector<FitKernel> fit_kernels(int R) {
   std::vector<FitKernel> out;
-  for (double kappa : fit_kernel_kappas(R)) out.push_back({kappa, false});
+  for (double kappa : fit_kernel_kappas(R)) out.push_back({kappa, KernelMode::plain});
   if (R < 32 || R > SphereMapKernel::kMaxResolution) return out;
   const double texel = std::sqrt(4.0 * kPi / (2.0 * double(R) * double(R)));
-  for (double widths : {0.75, 1.5, 3.0}) out.push_back({1.0 / ((widths * texel) * (widths * texel)), true});
+  const auto kappa_of = [&](double widths) { return 1.0 / ((widths * texel) * (widths * texel)); };
+  for (double widths : {0.75, 1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::sharpened});
+  for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::local_linear});
   return out;
 }
 
@@ -748,7 +752,7 @@ inline std::vector<FitKernel> fit_kernels(int R) {
 /// plain sum's mean over them, and the allowance 2/√n, n = set_rays · (their share of the plain flux)
 /// (the rays that fell there, for rays of equal flux). Returns {lowering, allowance}.
 inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const SphereMapKernel& kernel,
-                                                    std::uint64_t set_rays, bool sharpened = false) {
+                                                    std::uint64_t set_rays, KernelMode mode = KernelMode::plain) {
   const int R = level.map_resolution;
   if (level.apls.empty() || set_rays == 0) return {1.0, 0.0};
   SphereMap sum(R, 1);
@@ -758,7 +762,7 @@ inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const
     for (std::size_t t = 0; t < sum.texel_count(); ++t)
       for (int c = 0; c < C; ++c) sum.data()[t] += v[t * std::size_t(C) + std::size_t(c)];
   }
-  const SphereMap smooth = sharpened ? kernel.apply_sharpened(sum) : kernel.apply(sum);
+  const SphereMap smooth = kernel.apply(sum, mode);
   std::vector<std::uint32_t> order(sum.texel_count());
   for (std::size_t t = 0; t < order.size(); ++t) order[t] = std::uint32_t(t);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -794,7 +798,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     const AplLevel built = set.levels[k];
     std::vector<FitCandidate> tried;
     FitCandidate best{built.map_resolution, 0.0, INFINITY};
-    const auto grade = [&](int R, double kappa, bool sharpened, std::vector<double>& errors) {
+    const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
       const LevelErrors row = evaluate_level(set, k, ref, o);
       double cost = 0;
       errors.clear();
@@ -802,7 +806,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         errors.push_back(e.relative_rmse);
         if (std::isfinite(e.relative_rmse) && e.relative_rmse > 0) cost += std::log(e.relative_rmse);
       }
-      tried.push_back({R, kappa, cost, sharpened});
+      tried.push_back({R, kappa, cost, mode});
       return cost;
     };
     double plain_before = INFINITY;
@@ -810,17 +814,17 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     for (int R = built.map_resolution; R >= std::max(1, min_resolution); R /= 2) {
       const AplLevel at_r = downsampled_level(built, R);
       set.levels[k] = at_r;
-      const double plain = grade(R, 0.0, false, plain_errors);
+      const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       if (plain < best.cost) best = tried.back();
       for (const FitKernel& kernel : set_rays > 0 ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where
         // the fit's patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7°
         // lowered the peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10).
-        const auto [lowering, allowance] = kernel_peak_change(at_r, *kernel_for(R, kappa), set_rays, kernel.sharpened);
+        const auto [lowering, allowance] = kernel_peak_change(at_r, *kernel_for(R, kappa), set_rays, kernel.mode);
         if (lowering > allowance) continue;
-        set.levels[k] = smoothed_level(at_r, *kernel_for(R, kappa), 0, kernel.sharpened);
-        const double cost = grade(R, kappa, kernel.sharpened, kernel_errors);
+        set.levels[k] = smoothed_level(at_r, *kernel_for(R, kappa), 0, kernel.mode);
+        const double cost = grade(R, kappa, kernel.mode, kernel_errors);
         // A kernel must not give away any distance against the same maps unsmoothed: its bias is largest at
         // a narrow peak, which the fit's patches (coarser than the peak) see only in part, at some distances
         // (a cos^50 spot: σ 1.7° won the geometric mean by the near field and doubled the error at d ≥ 5).
@@ -840,10 +844,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     }
     set.levels[k] = downsampled_level(built, best.resolution);
     if (best.kappa > 0)
-      set.levels[k] = smoothed_level(set.levels[k], *kernel_for(best.resolution, best.kappa), 0, best.sharpened);
+      set.levels[k] = smoothed_level(set.levels[k], *kernel_for(best.resolution, best.kappa), 0, best.mode);
     choice.resolution.push_back(best.resolution);
     choice.kappa.push_back(best.kappa);
-    choice.sharpened.push_back(best.kappa > 0 && best.sharpened);
+    choice.mode.push_back(best.kappa > 0 ? best.mode : KernelMode::plain);
     choice.tried.push_back(std::move(tried));
   }
   return choice;
@@ -887,7 +891,7 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
     const ResolutionChoice far_choice = fit_map_resolutions(far, far_ref, far_options, min_resolution, train_rays);
     c.far_field_resolution = far_choice.resolution.at(0);
     c.far_field_kappa = far_choice.kappa.at(0);
-    c.far_field_sharpened = far_choice.sharpened.at(0);
+    c.far_field_mode = far_choice.mode.at(0);
   }
   RayHalf test(odd, 1);
   AplErrorReport report = evaluate_apl_errors(set, test, options);
@@ -940,7 +944,7 @@ inline bool apply_held_out_fit(AplSet& set, const AplErrorReport& report, const 
       if (choice->resolution[k] <= set.levels[k].map_resolution)
         set.levels[k] = fitted_level(set.levels[k], choice->resolution[k],
                                      k < choice->kappa.size() ? choice->kappa[k] : 0.0,
-                                     k < choice->sharpened.size() && choice->sharpened[k]);
+                                     k < choice->mode.size() ? choice->mode[k] : KernelMode::plain);
   store_error_tables(set, report);
   return true;
 }

@@ -41,6 +41,20 @@
 
 LUMX_NAMESPACE_BEGIN
 
+/// How a kernel K smooths a level's maps: K·f alone; sharpened, G + α(G − K·G) with G = K·f
+/// (SphereMapKernel::sharpening_gain); or as the weights of a local linear fit inside the rays' support
+/// (SphereMapKernel::local_linear_gain).
+enum class KernelMode { plain, sharpened, local_linear };
+
+/// "", "sharpened" or "local linear" (for reports and the bundle's provenance).
+inline const char* kernel_mode_name(KernelMode mode) {
+  switch (mode) {
+    case KernelMode::sharpened: return "sharpened";
+    case KernelMode::local_linear: return "local linear";
+    default: return "";
+  }
+}
+
 class SphereMapKernel {
  public:
   /// Largest resolution the kernel is built for: it finds neighbours by comparing every pair of texel
@@ -77,6 +91,7 @@ class SphereMapKernel {
       }
       for (const auto& [t, w] : row) by_target[t].push_back({std::uint32_t(s), float(w / sum)});
     }
+    centres_ = std::move(centre);
     offsets_.assign(std::size_t(T) + 1, 0);
     for (int t = 0; t < T; ++t) offsets_[std::size_t(t) + 1] = offsets_[std::size_t(t)] + std::uint32_t(by_target[std::size_t(t)].size());
     sources_.reserve(offsets_.back());
@@ -108,6 +123,12 @@ class SphereMapKernel {
   double sigma() const { return 1.0 / std::sqrt(kappa_); }
   /// Non-zero weights in all (the cost of apply, per channel).
   std::size_t weight_count() const { return weights_.size(); }
+
+  /// Row t of the kernel: f(s, w_ts) for every source texel s within reach of target texel t (apply()'s sum).
+  template <class F>
+  void for_each_source(std::size_t t, F&& f) const {
+    for (std::uint32_t i = offsets_.at(t); i < offsets_.at(t + 1); ++i) f(std::size_t(sources_[i]), double(weights_[i]));
+  }
 
   /// The smoothed map (same resolution and channels; flux kept). Throws for another resolution.
   SphereMap apply(const SphereMap& in) const {
@@ -197,10 +218,86 @@ class SphereMapKernel {
   /// One map sharpened alone: apply_with_gain(in, sharpening_gain(in)).
   SphereMap apply_sharpened(const SphereMap& in) const { return apply_with_gain(in, sharpening_gain(in)); }
 
+  /// The gain that turns this kernel into a local linear estimate for maps that sum to `total` (any
+  /// channels; their sum is used). At each texel t where the sum is non-zero (the support: directions the
+  /// rays reached), f is fitted by a + b·(u, v) in the tangent plane at ω_t (u, v the source directions'
+  /// components along two tangent axes), by least squares weighted by the kernel's row t over the support's
+  /// texels only; the estimate is a (Fan & Gijbels 1996 §3.2; on the sphere the tangent-plane projection is
+  /// the local chart). Where the support is symmetric about t, a equals K·f up to the normalisation; where
+  /// the support ends (a Lambertian emitter's horizon, a shadow's border), the plain kernel loses the mass
+  /// that falls outside and leaks it across, a bias of order σ·|∇f| there, while the linear term absorbs the
+  /// slope, leaving O(σ²) as inside (the boundary bias of local constant estimates, §3.2.5). Outside the
+  /// support the estimate is 0: empty directions stay exactly dark at this resolution. Clamped at 0 and
+  /// rescaled to the sum's flux; the gain is its ratio to K·total (0 where K·total is 0). A texel whose
+  /// weighted support is degenerate (too few texels in reach to fit a slope) keeps the local mean.
+  SphereMap local_linear_gain(const SphereMap& total) const {
+    SphereMap sum(resolution_, 1);
+    const int C = total.channels();
+    for (std::size_t t = 0; t < sum.texel_count(); ++t)
+      for (int c = 0; c < C; ++c) sum.data()[t] += total.data()[t * std::size_t(C) + std::size_t(c)];
+    const SphereMap once = apply(sum);
+    SphereMap fitted(resolution_, 1);
+    double flux = 0, kept = 0;
+    const std::size_t T = sum.texel_count();
+    for (std::size_t t = 0; t < T; ++t) {
+      flux += double(sum.data()[t]);
+      if (!(sum.data()[t] > 0)) continue;
+      const glm::dvec3& n = centres_[t];
+      const glm::dvec3 e1 = glm::normalize(glm::cross(std::abs(n.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0), n));
+      const glm::dvec3 e2 = glm::cross(n, e1);
+      // Normal equations of the weighted fit, in tangent coordinates relative to ω_t (so u, v ~ σ).
+      double s0 = 0, su = 0, sv = 0, suu = 0, suv = 0, svv = 0, f0 = 0, fu = 0, fv = 0;
+      for (std::uint32_t i = offsets_[t]; i < offsets_[t + 1]; ++i) {
+        const std::size_t src = sources_[i];
+        const double f = double(sum.data()[src]);
+        if (!(f > 0)) continue;
+        const double w = double(weights_[i]);
+        const double u = glm::dot(centres_[src], e1), v = glm::dot(centres_[src], e2);
+        s0 += w, su += w * u, sv += w * v, suu += w * u * u, suv += w * u * v, svv += w * v * v;
+        f0 += w * f, fu += w * u * f, fv += w * v * f;
+      }
+      // a from the 3 × 3 system by Cramer's rule; the local mean where the fit cannot see a slope.
+      const double det = s0 * (suu * svv - suv * suv) - su * (su * svv - suv * sv) + sv * (su * suv - suu * sv);
+      double a = s0 > 0 ? f0 / s0 : 0.0;
+      if (std::abs(det) > 1e-6 * s0 * suu * svv && suu * svv > 0) {
+        const double det_a = f0 * (suu * svv - suv * suv) - su * (fu * svv - suv * fv) + sv * (fu * suv - suu * fv);
+        a = det_a / det;
+      }
+      fitted.data()[t] = float(std::max(0.0, a));
+      kept += double(fitted.data()[t]);
+    }
+    const double rescale = kept > 0 ? flux / kept : 0.0;
+    SphereMap gain(resolution_, 1);
+    for (std::size_t t = 0; t < T; ++t) {
+      const double g = double(once.data()[t]);
+      gain.data()[t] = g > 0 ? float(double(fitted.data()[t]) * rescale / g) : 0.0f;
+    }
+    return gain;
+  }
+
+  /// The gain of `mode` for maps that sum to `total` (sharpening_gain or local_linear_gain; all ones for
+  /// plain).
+  SphereMap gain(const SphereMap& total, KernelMode mode) const {
+    if (mode == KernelMode::sharpened) return sharpening_gain(total);
+    if (mode == KernelMode::local_linear) return local_linear_gain(total);
+    SphereMap ones(resolution_, 1);
+    std::fill(ones.values().begin(), ones.values().end(), 1.0f);
+    return ones;
+  }
+
+  /// One map smoothed alone in `mode`.
+  SphereMap apply(const SphereMap& in, KernelMode mode) const {
+    return mode == KernelMode::plain ? apply(in) : apply_with_gain(in, gain(in, mode));
+  }
+
+  /// One map by local linear regression alone: apply_with_gain(in, local_linear_gain(in)).
+  SphereMap apply_local_linear(const SphereMap& in) const { return apply_with_gain(in, local_linear_gain(in)); }
+
 
  private:
   int resolution_ = 0;
   double kappa_ = 0;
+  std::vector<glm::dvec3> centres_;  ///< texel centres (unit directions)
   std::vector<std::uint32_t> offsets_, sources_;
   std::vector<float> weights_;
 };

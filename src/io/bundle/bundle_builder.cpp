@@ -52,19 +52,20 @@ AplBuildOptions with_threads(AplBuildOptions bo) {
 /// How the held-out fit left the maps of every level and of the far field, in words, for the manifest's
 /// provenance ("level 0: R 64, von Mises-Fisher kernel sigma 3.4 deg; ...; far field: ...").
 std::string map_smoothing_note(const ResolutionChoice& c) {
-  const auto one = [](int R, double kappa, bool sharpened) {
+  const auto one = [](int R, double kappa, KernelMode mode) {
     std::string t = "R " + std::to_string(R);
     if (!(kappa > 0)) return t + ", not smoothed";
     char sigma[32];
     std::snprintf(sigma, sizeof sigma, "%.2f", 180.0 / kPi / std::sqrt(kappa));
-    return t + ", von Mises-Fisher kernel sigma " + sigma + " deg" + (sharpened ? ", sharpened" : "");
+    return t + ", von Mises-Fisher kernel sigma " + sigma + " deg" +
+           (mode == KernelMode::plain ? std::string() : std::string(", ") + kernel_mode_name(mode));
   };
   std::string out;
   for (std::size_t k = 0; k < c.resolution.size(); ++k)
     out += "level " + std::to_string(k) + ": " +
-           one(c.resolution[k], k < c.kappa.size() ? c.kappa[k] : 0.0, k < c.sharpened.size() && c.sharpened[k]) + "; ";
+           one(c.resolution[k], k < c.kappa.size() ? c.kappa[k] : 0.0, k < c.mode.size() ? c.mode[k] : KernelMode::plain) + "; ";
   if (c.far_field_resolution > 0)
-    out += "far field: " + one(c.far_field_resolution, c.far_field_kappa, c.far_field_sharpened);
+    out += "far field: " + one(c.far_field_resolution, c.far_field_kappa, c.far_field_mode);
   else if (!out.empty())
     out.resize(out.size() - 2);
   return out;
@@ -196,7 +197,7 @@ BundleBuildResult build_bundle(RaySource& rays, const std::string& out, const Bu
     const int fitted_r = result.held_out.choice.far_field_resolution;
     const double fitted_kappa = result.held_out.choice.far_field_kappa;
     far_set.levels.push_back(fitted_r > 0 && fitted_r <= built_level0.map_resolution
-                                 ? fitted_level(built_level0, fitted_r, fitted_kappa, result.held_out.choice.far_field_sharpened)
+                                 ? fitted_level(built_level0, fitted_r, fitted_kappa, result.held_out.choice.far_field_mode)
                                  : set.levels.at(0));
     const Photometry far = far_field_photometry(far_set, 0, grid);
     wo.attachments.push_back({"far_field.ies", "application/x-ies-lm63", format_ies(far)});
@@ -206,7 +207,8 @@ BundleBuildResult build_bundle(RaySource& rays, const std::string& out, const Bu
     result.far_field_resolution = far_set.levels[0].map_resolution;
     result.far_field_kernel_sigma_deg =
         fitted_r > 0 && fitted_kappa > 0 ? 180.0 / kPi / std::sqrt(fitted_kappa) : 0.0;
-    result.far_field_kernel_sharpened = result.far_field_kernel_sigma_deg > 0 && result.held_out.choice.far_field_sharpened;
+    result.far_field_kernel_mode =
+        result.far_field_kernel_sigma_deg > 0 ? result.held_out.choice.far_field_mode : KernelMode::plain;
   }
   const auto far_done = Clock::now();
   for (const auto& attachment : o.attachments) wo.attachments.push_back(attachment);
