@@ -62,7 +62,7 @@ def main(argv):
         ax.axhline(2.0, color="tab:green", linewidth=0.8)  # issue target for the Lambertian emitters and spots
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_ylim(1.0, 1000.0)
+        ax.set_ylim(0.5, 1000.0)
         ax.set_title(emitter, fontsize=9)
         ax.set_xlabel("relative distance d")
         ax.grid(True, which="both", linewidth=0.3)
