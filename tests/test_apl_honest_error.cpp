@@ -74,6 +74,16 @@ std::vector<double> true_errors(const std::vector<std::vector<double>>& exact, c
   return out;
 }
 
+/// Level k's irradiance at the evaluation points `dirs` of sphere s, each queried alone as a renderer does.
+std::vector<double> level_at_points(const AplSet& set, std::size_t k, const MeasurementSpheres& ms, std::size_t s,
+                                    const std::vector<glm::dvec3>& dirs) {
+  std::vector<double> model(dirs.size());
+  for (std::size_t p = 0; p < dirs.size(); ++p)
+    model[p] = luminance_of(set.channels, irradiance(set, k, glm::vec3(ms.centre() + ms.radius(s) * dirs[p]),
+                                                     glm::vec3(-dirs[p])).irradiance);
+  return model;
+}
+
 }  // namespace
 
 TEST(AnalyticEmitters, DiskQuadratureMatchesTheClosedFormOnTheAxis) {
@@ -455,10 +465,7 @@ TEST(PinholeBoxStudy, DISABLED_BordersNotRaysLimitTheFinestLevel) {
         std::printf("%8llu rays (%7llu leave), R %3d, %3zu APLs:", (unsigned long long)n,
                     (unsigned long long)rays->info().ray_count, R, set.levels[k].size());
         for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
-          std::vector<double> model(dirs.size());
-          for (std::size_t p = 0; p < dirs.size(); ++p)
-            model[p] = luminance_of(set.channels, irradiance(set, k, glm::vec3(ms.centre() + ms.radius(s) * dirs[p]),
-                                                             glm::vec3(-dirs[p])).irradiance);
+          const std::vector<double> model = level_at_points(set, k, ms, s, dirs);
           const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
           std::printf(" %6.2f", e);
           const double doc = documented[n_index][r_index][s];
@@ -530,10 +537,7 @@ TEST(PinholeBoxStudy, DISABLED_ExactBeamsAtTheSourcesBoundWhatMapsCanDo) {
     }
     std::printf("exact beams at the sources, R %4d:", R);
     for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
-      std::vector<double> model(dirs.size());
-      for (std::size_t p = 0; p < dirs.size(); ++p)
-        model[p] = luminance_of(set.channels, irradiance(set, 0, glm::vec3(ms.centre() + ms.radius(s) * dirs[p]),
-                                                         glm::vec3(-dirs[p])).irradiance);
+      const std::vector<double> model = level_at_points(set, 0, ms, s, dirs);
       const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
       std::printf(" %6.2f", e);
       EXPECT_NEAR(e, documented[row][s], 0.01) << "R " << R << ", sphere " << s;
@@ -710,10 +714,7 @@ TEST(SpotStudy, DISABLED_MoreRaysHelpOnlyNearTheSpots) {
       int col = 0;
       for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
         if (ms.relative_distances()[s] < 1) continue;
-        std::vector<double> model(dirs.size());
-        for (std::size_t p = 0; p < dirs.size(); ++p)
-          model[p] = luminance_of(set.channels, irradiance(set, k, glm::vec3(ms.centre() + ms.radius(s) * dirs[p]),
-                                                           glm::vec3(-dirs[p])).irradiance);
+        const std::vector<double> model = level_at_points(set, k, ms, s, dirs);
         const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
         std::printf(" %6.2f", e);
         const double doc = documented[which - 2][n_index][col++];
@@ -758,10 +759,7 @@ TEST(SpotStudy, DISABLED_MoreRaysHelpOnlyNearTheSpots) {
       std::printf("%s, exact map at the centre, R %d:", em->name().c_str(), R);
       for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
         if (ms.relative_distances()[s] < 1) continue;
-        std::vector<double> model(dirs.size());
-        for (std::size_t p = 0; p < dirs.size(); ++p)
-          model[p] = luminance_of(set.channels, irradiance(set, 0, glm::vec3(ms.centre() + ms.radius(s) * dirs[p]),
-                                                           glm::vec3(-dirs[p])).irradiance);
+        const std::vector<double> model = level_at_points(set, 0, ms, s, dirs);
         const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
         std::printf(" %6.2f", e);
         EXPECT_NEAR(e, documented[which - 2][R == 64 ? 2 : 3][col++], 0.01) << "exact map, R " << R << ", sphere " << s;
