@@ -124,12 +124,6 @@ class SphereMapKernel {
   /// Non-zero weights in all (the cost of apply, per channel).
   std::size_t weight_count() const { return weights_.size(); }
 
-  /// Row t of the kernel: f(s, w_ts) for every source texel s within reach of target texel t (apply()'s sum).
-  template <class F>
-  void for_each_source(std::size_t t, F&& f) const {
-    for (std::uint32_t i = offsets_.at(t); i < offsets_.at(t + 1); ++i) f(std::size_t(sources_[i]), double(weights_[i]));
-  }
-
   /// The smoothed map (same resolution and channels; flux kept). Throws for another resolution.
   SphereMap apply(const SphereMap& in) const {
     if (in.resolution() != resolution_)
