@@ -25,6 +25,15 @@ glm::dvec3 texel_direction(int R, int x, int y) {
       sphere_map::uv_to_direction({(float(x) + 0.5f) / float(2 * R), (float(y) + 0.5f) / float(R)})));
 }
 
+/// A map of resolution R whose texels hold f at their centres.
+template <class F>
+SphereMap map_of(int R, F&& f) {
+  SphereMap m(R, 1);
+  for (int y = 0; y < R; ++y)
+    for (int x = 0; x < 2 * R; ++x) m.at(x, y, 0) = float(f(texel_direction(R, x, y)));
+  return m;
+}
+
 }  // namespace
 
 TEST(SphereMapKernel, KeepsFluxAndSpreadsOneTexelAsTheKernel) {
@@ -136,13 +145,8 @@ namespace {
 
 /// A cos^m lobe about +z sampled at the texel centres, scaled to `flux` (texel values sum to it).
 SphereMap lobe_map(int R, double m, double flux) {
-  SphereMap map(R, 1);
-  double sum = 0;
-  for (int y = 0; y < R; ++y)
-    for (int x = 0; x < 2 * R; ++x) {
-      map.at(x, y, 0) = float(std::pow(std::max(0.0, texel_direction(R, x, y).z), m));
-      sum += map.at(x, y, 0);
-    }
+  SphereMap map = map_of(R, [m](const glm::dvec3& w) { return std::pow(std::max(0.0, w.z), m); });
+  const double sum = map_sum(map);
   for (float& v : map.values()) v = float(double(v) * flux / sum);
   return map;
 }
@@ -240,19 +244,6 @@ TEST(SphereMapKernel, SharpenedLevelSumsToTheSharpenedSumWhereSharpeningEachMapF
   for (std::size_t i = 0; i < level.apls.size(); ++i) EXPECT_EQ(one.apls[i].map.values(), shared.apls[i].map.values());
 }
 
-namespace {
-/// A map whose texels hold f at their centres.
-template <class F>
-SphereMap map_of(int R, F&& f) {
-  SphereMap m(R, 1);
-  for (int y = 0; y < R; ++y)
-    for (int x = 0; x < 2 * R; ++x)
-      m.at(x, y, 0) = float(f(glm::dvec3(sphere_map::uv_to_direction(
-          {(float(x) + 0.5f) / float(2 * R), (float(y) + 0.5f) / float(R)}))));
-  return m;
-}
-}  // namespace
-
 TEST(SphereMapKernel, LocalLinearKeepsAConstantInsideItsSupportAndItsOutsideDark) {
   // A uniform cap (z > 0.5, 10 cd): a local linear fit reproduces a constant exactly wherever it is fitted,
   // right up to the cap's rim, and leaves every texel outside the support at 0. The plain kernel loses
@@ -295,7 +286,7 @@ TEST(SphereMapKernel, LocalLinearFollowsALambertianEmitterToItsHorizon) {
     const SphereMap s = k.apply(lambert, modes[m]);
     for (int y = 0; y < R; ++y)
       for (int x = 0; x < 2 * R; ++x) {
-        const glm::dvec3 w(sphere_map::uv_to_direction({(float(x) + 0.5f) / float(2 * R), (float(y) + 0.5f) / float(R)}));
+        const glm::dvec3 w = texel_direction(R, x, y);
         const double v = s.at(x, y, 0);
         if (w.z > 0 && w.z < band) worst[m] = std::max(worst[m], std::abs(v - 100.0 * w.z) / 100.0);
         if (w.z <= 0) leak[m] = std::max(leak[m], v / 100.0);

@@ -684,11 +684,7 @@ inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& ker
   SphereMap gain;
   if (with_gain && n > 0) {
     SphereMap total(kernel.resolution(), 1);
-    for (const Apl& a : level.apls) {
-      const int C = a.map.channels();
-      for (std::size_t t = 0; t < total.texel_count(); ++t)
-        for (int c = 0; c < C; ++c) total.data()[t] += a.map.data()[t * std::size_t(C) + std::size_t(c)];
-    }
+    for (const Apl& a : level.apls) accumulate_channels(total, a.map);
     gain = kernel.gain(total, mode);
   }
   const auto run = [&](std::size_t from, std::size_t to) {
@@ -756,12 +752,7 @@ inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const
   const int R = level.map_resolution;
   if (level.apls.empty() || set_rays == 0) return {1.0, 0.0};
   SphereMap sum(R, 1);
-  for (const Apl& a : level.apls) {
-    const int C = a.map.channels();
-    const float* v = a.map.data();
-    for (std::size_t t = 0; t < sum.texel_count(); ++t)
-      for (int c = 0; c < C; ++c) sum.data()[t] += v[t * std::size_t(C) + std::size_t(c)];
-  }
+  for (const Apl& a : level.apls) accumulate_channels(sum, a.map);
   const SphereMap smooth = kernel.apply(sum, mode);
   std::vector<std::uint32_t> order(sum.texel_count());
   for (std::size_t t = 0; t < order.size(); ++t) order[t] = std::uint32_t(t);

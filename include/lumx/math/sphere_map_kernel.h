@@ -55,6 +55,14 @@ inline const char* kernel_mode_name(KernelMode mode) {
   }
 }
 
+/// sum (one channel) += the sum of `map`'s channels, texel by texel (same resolution): the one-channel
+/// total a level's gains are computed from.
+inline void accumulate_channels(SphereMap& sum, const SphereMap& map) {
+  const int C = map.channels();
+  for (std::size_t t = 0; t < sum.texel_count(); ++t)
+    for (int c = 0; c < C; ++c) sum.data()[t] += map.data()[t * std::size_t(C) + std::size_t(c)];
+}
+
 class SphereMapKernel {
  public:
   /// Largest resolution the kernel is built for: it finds neighbours by comparing every pair of texel
@@ -162,9 +170,7 @@ class SphereMapKernel {
   /// ratio to G per texel (0 where G is, at most 1 + α).
   SphereMap sharpening_gain(const SphereMap& total) const {
     SphereMap sum(resolution_, 1);
-    const int C = total.channels();
-    for (std::size_t t = 0; t < sum.texel_count(); ++t)
-      for (int c = 0; c < C; ++c) sum.data()[t] += total.data()[t * std::size_t(C) + std::size_t(c)];
+    accumulate_channels(sum, total);
     const SphereMap once = apply(sum), twice = apply(once);
     const double alpha = sharpening_strength();
     SphereMap gain(resolution_, 1);
@@ -226,9 +232,7 @@ class SphereMapKernel {
   /// weighted support is degenerate (too few texels in reach to fit a slope) keeps the local mean.
   SphereMap local_linear_gain(const SphereMap& total) const {
     SphereMap sum(resolution_, 1);
-    const int C = total.channels();
-    for (std::size_t t = 0; t < sum.texel_count(); ++t)
-      for (int c = 0; c < C; ++c) sum.data()[t] += total.data()[t * std::size_t(C) + std::size_t(c)];
+    accumulate_channels(sum, total);
     const SphereMap once = apply(sum);
     SphereMap fitted(resolution_, 1);
     double flux = 0, kept = 0;
@@ -283,9 +287,6 @@ class SphereMapKernel {
   SphereMap apply(const SphereMap& in, KernelMode mode) const {
     return mode == KernelMode::plain ? apply(in) : apply_with_gain(in, gain(in, mode));
   }
-
-  /// One map by local linear regression alone: apply_with_gain(in, local_linear_gain(in)).
-  SphereMap apply_local_linear(const SphereMap& in) const { return apply_with_gain(in, local_linear_gain(in)); }
 
 
  private:
