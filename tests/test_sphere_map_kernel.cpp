@@ -64,6 +64,66 @@ TEST(SphereMapKernel, KeepsFluxAndSpreadsOneTexelAsTheKernel) {
   for (float v : s.values()) EXPECT_GE(v, 0.0f);
 }
 
+TEST(SphereMapKernel, GridSearchAndSparseScatterAgreeWithTheDefinitionBitForBit) {
+  // The kernel written out from its definition (header comment): every pair of texel centres, the
+  // weights of each source normalised over its targets in increasing order, each output texel the sum over
+  // its sources in increasing order, in double. The grid search must find the same neighbours and the
+  // sparse scatter (a map with a few lit texels) and the dense gather (a full map) must add the same
+  // products in the same order: equal to the last bit. κ from a kernel wider than the sphere (the cut
+  // takes every texel) to one narrower than a texel.
+  const int R = 16, W = 2 * R, T = W * R;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 10.0f);
+  SphereMap dense(R, 3), sparse(R, 3);
+  for (float& v : dense.values()) v = u(rng);
+  for (int i = 0; i < 5; ++i)
+    for (int c = 0; c < 3; ++c) sparse.values()[std::size_t((37 * i + 11) % T) * 3 + std::size_t(c)] = u(rng);
+  for (const double kappa : {0.5, 20.0, 300.0, 5000.0}) {
+    const SphereMapKernel k(R, kappa);
+    const double cut = std::log(1e3) / kappa;
+    std::vector<std::vector<std::pair<int, float>>> by_target(T);
+    std::size_t count = 0;
+    for (int s = 0; s < T; ++s) {
+      const glm::dvec3 cs = texel_direction(R, s % W, s / W);
+      std::vector<std::pair<int, double>> row;
+      double sum = 0;
+      for (int t = 0; t < T; ++t) {
+        const double one_minus_cos = 1.0 - glm::dot(cs, texel_direction(R, t % W, t / W));
+        if (one_minus_cos > cut) continue;
+        row.push_back({t, std::exp(-kappa * one_minus_cos)});
+        sum += row.back().second;
+      }
+      for (const auto& [t, w] : row) by_target[std::size_t(t)].push_back({s, float(w / sum)});
+      count += row.size();
+    }
+    EXPECT_EQ(k.weight_count(), count) << kappa;
+    for (const SphereMap* in : {&dense, &sparse}) {
+      const SphereMap out = k.apply(*in);
+      int differing = 0;
+      for (int t = 0; t < T; ++t)
+        for (int c = 0; c < 3; ++c) {
+          double v = 0;
+          for (const auto& [s, w] : by_target[std::size_t(t)]) v += double(w) * double(in->values()[std::size_t(s) * 3 + std::size_t(c)]);
+          differing += out.values()[std::size_t(t) * 3 + std::size_t(c)] != float(v);
+        }
+      EXPECT_EQ(differing, 0) << "kappa " << kappa << (in == &sparse ? ", sparse map" : ", dense map");
+    }
+  }
+}
+
+TEST(SphereMapKernel, BuildsAtTheLargestResolutionAndKeepsFlux) {
+  // R 128, σ = 1.5 texel widths: about π (3.7 · 1.5)² ≈ 97 weights per texel, and a sparse map's flux kept.
+  const int R = SphereMapKernel::kMaxResolution;
+  const double texel = std::sqrt(4.0 * kPi / (2.0 * R * R));
+  const SphereMapKernel k(R, 1.0 / ((1.5 * texel) * (1.5 * texel)));
+  const double per_texel = double(k.weight_count()) / (2.0 * R * R);
+  EXPECT_GT(per_texel, 85.0);
+  EXPECT_LT(per_texel, 110.0);
+  SphereMap m(R, 1);
+  m.at(5, 7, 0) = 3.0f, m.at(200, 100, 0) = 2.0f, m.at(127, 127, 0) = 1.0f;
+  EXPECT_NEAR(map_sum(k.apply(m)), 6.0, 6.0 * 1e-6);
+}
+
 TEST(SphereMapKernel, CrossesTheEquatorSeamAsTheSphereDoes) {
   // A texel on the upper square's border (next to the equator) hands light to the lower hemisphere as a
   // Gaussian of σ = 1/√κ across the equator would: the fraction Φ(−elevation/σ) of it (the kernel works on

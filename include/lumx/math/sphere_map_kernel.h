@@ -65,9 +65,10 @@ inline void accumulate_channels(SphereMap& sum, const SphereMap& map) {
 
 class SphereMapKernel {
  public:
-  /// Largest resolution the kernel is built for: it finds neighbours by comparing every pair of texel
-  /// centres (2R² × 2R² dot products: 6.7·10⁷ at R 64, a few tenths of a second).
-  static constexpr int kMaxResolution = 64;
+  /// Largest resolution the kernel is built for. Finding each texel's neighbours is a grid search (cost
+  /// ∝ the weights), so the limit is memory: at R 128 a kernel of σ = 1.5 texel widths holds 3.2·10⁶
+  /// weights (25 MB with both orders of them).
+  static constexpr int kMaxResolution = 128;
 
   /// The kernel for maps of resolution R (1..kMaxResolution) and concentration κ > 0 (1/rad²).
   SphereMapKernel(int resolution, double kappa) : resolution_(resolution), kappa_(kappa) {
@@ -83,29 +84,66 @@ class SphereMapKernel {
         centre[std::size_t(y) * std::size_t(W) + std::size_t(x)] = glm::normalize(glm::dvec3(sphere_map::uv_to_direction(
             {(float(x) + 0.5f) / float(W), (float(y) + 0.5f) / float(resolution)})));
     const double cut = std::log(1e3) / kappa;  // 1 − cos of the truncation angle
-    // Per source: its targets and normalised weights; then gathered per target (CSR), so that applying
-    // the kernel writes each output texel once.
-    std::vector<std::vector<std::pair<std::uint32_t, float>>> by_target(static_cast<std::size_t>(T));
+    // Neighbours by a uniform grid over the cube [−1, 1]³ whose cells are at least the truncation chord
+    // √(2·cut) wide (|ω − ω'|² = 2(1 − ω·ω')), so every neighbour of a texel lies in the 27 cells around its
+    // own. Each source's targets are then visited in increasing index, as a scan of all texels would, so
+    // the weights and their sums do not depend on how the neighbours were found.
+    const double chord = std::sqrt(2.0 * cut);
+    const int cells = std::clamp(int(2.0 / chord), 1, 256);
+    const auto cell_of = [&](double v) { return std::clamp(int((v + 1.0) * 0.5 * cells), 0, cells - 1); };
+    std::vector<std::uint32_t> cell_start(std::size_t(cells) * cells * cells + 1, 0), in_cell(static_cast<std::size_t>(T));
+    std::vector<std::uint32_t> cell_index(static_cast<std::size_t>(T));
+    for (int t = 0; t < T; ++t) {
+      const glm::dvec3& c = centre[std::size_t(t)];
+      cell_index[std::size_t(t)] = std::uint32_t((cell_of(c.z) * cells + cell_of(c.y)) * cells + cell_of(c.x));
+      ++cell_start[cell_index[std::size_t(t)] + 1];
+    }
+    for (std::size_t i = 1; i < cell_start.size(); ++i) cell_start[i] += cell_start[i - 1];
+    {
+      std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+      for (int t = 0; t < T; ++t) in_cell[fill[cell_index[std::size_t(t)]]++] = std::uint32_t(t);  // increasing t per cell
+    }
+    // Per source (increasing): its targets (increasing) and normalised weights, kept in source order for
+    // the sparse scatter and gathered per target (CSR, sources increasing) for the dense apply.
+    std::vector<std::uint32_t> count_by_target(static_cast<std::size_t>(T), 0);
     std::vector<std::pair<std::uint32_t, double>> row;
+    scatter_offsets_.assign(std::size_t(T) + 1, 0);
     for (int s = 0; s < T; ++s) {
       row.clear();
+      const glm::dvec3& cs = centre[std::size_t(s)];
+      const int cx = cell_of(cs.x), cy = cell_of(cs.y), cz = cell_of(cs.z);
+      for (int z = std::max(0, cz - 1); z <= std::min(cells - 1, cz + 1); ++z)
+        for (int y = std::max(0, cy - 1); y <= std::min(cells - 1, cy + 1); ++y)
+          for (int x = std::max(0, cx - 1); x <= std::min(cells - 1, cx + 1); ++x) {
+            const std::size_t cell = (std::size_t(z) * std::size_t(cells) + std::size_t(y)) * std::size_t(cells) + std::size_t(x);
+            for (std::uint32_t i = cell_start[cell]; i < cell_start[cell + 1]; ++i) {
+              const std::uint32_t t = in_cell[i];
+              const double one_minus_cos = 1.0 - glm::dot(cs, centre[t]);
+              if (one_minus_cos <= cut) row.push_back({t, std::exp(-kappa * one_minus_cos)});
+            }
+          }
+      std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
       double sum = 0;
-      for (int t = 0; t < T; ++t) {
-        const double one_minus_cos = 1.0 - glm::dot(centre[std::size_t(s)], centre[std::size_t(t)]);
-        if (one_minus_cos > cut) continue;
-        const double w = std::exp(-kappa * one_minus_cos);
-        row.push_back({std::uint32_t(t), w});
-        sum += w;
+      for (const auto& entry : row) sum += entry.second;
+      for (const auto& [t, w] : row) {
+        scatter_targets_.push_back(t);
+        scatter_weights_.push_back(float(w / sum));
+        ++count_by_target[t];
       }
-      for (const auto& [t, w] : row) by_target[t].push_back({std::uint32_t(s), float(w / sum)});
+      scatter_offsets_[std::size_t(s) + 1] = std::uint32_t(scatter_targets_.size());
     }
     centres_ = std::move(centre);
     offsets_.assign(std::size_t(T) + 1, 0);
-    for (int t = 0; t < T; ++t) offsets_[std::size_t(t) + 1] = offsets_[std::size_t(t)] + std::uint32_t(by_target[std::size_t(t)].size());
-    sources_.reserve(offsets_.back());
-    weights_.reserve(offsets_.back());
-    for (const auto& list : by_target)
-      for (const auto& [s, w] : list) sources_.push_back(s), weights_.push_back(w);
+    for (int t = 0; t < T; ++t) offsets_[std::size_t(t) + 1] = offsets_[std::size_t(t)] + count_by_target[std::size_t(t)];
+    sources_.resize(offsets_.back());
+    weights_.resize(offsets_.back());
+    std::vector<std::uint32_t> next(offsets_.begin(), offsets_.end() - 1);
+    for (int s = 0; s < T; ++s)
+      for (std::uint32_t i = scatter_offsets_[std::size_t(s)]; i < scatter_offsets_[std::size_t(s) + 1]; ++i) {
+        const std::uint32_t at = next[scatter_targets_[i]]++;
+        sources_[at] = std::uint32_t(s);
+        weights_[at] = scatter_weights_[i];
+      }
   }
 
   /// The kernel for (R, κ) from a small process-wide cache (the last 8 built; thread-safe): building one
@@ -133,6 +171,11 @@ class SphereMapKernel {
   std::size_t weight_count() const { return weights_.size(); }
 
   /// The smoothed map (same resolution and channels; flux kept). Throws for another resolution.
+  ///
+  /// out_t = Σ_s w_ts in_s, summed in double over s in increasing order. A map with few lit texels (an
+  /// APL's map of a few thousand rays) is scattered from its lit sources only; a dense one is gathered per
+  /// target. Both add the same products in the same order (a skipped source adds 0), so the result is the
+  /// same bit for bit either way.
   SphereMap apply(const SphereMap& in) const {
     if (in.resolution() != resolution_)
       throw std::invalid_argument("SphereMapKernel: a map of resolution " + std::to_string(in.resolution()) +
@@ -142,6 +185,21 @@ class SphereMapKernel {
     const float* src = in.data();
     float* dst = out.data();
     const std::size_t T = offsets_.size() - 1;
+    std::size_t lit_weights = 0;
+    for (std::size_t s = 0; s < T; ++s)
+      if (lit(src, s, C)) lit_weights += scatter_offsets_[s + 1] - scatter_offsets_[s];
+    if (4 * lit_weights < weights_.size()) {
+      std::vector<double> sum(T * std::size_t(C), 0.0);
+      for (std::size_t s = 0; s < T; ++s) {
+        if (!lit(src, s, C)) continue;
+        for (std::uint32_t i = scatter_offsets_[s]; i < scatter_offsets_[s + 1]; ++i)
+          for (int c = 0; c < C; ++c)
+            sum[std::size_t(scatter_targets_[i]) * std::size_t(C) + std::size_t(c)] +=
+                double(scatter_weights_[i]) * double(src[s * std::size_t(C) + std::size_t(c)]);
+      }
+      for (std::size_t i = 0; i < sum.size(); ++i) dst[i] = float(sum[i]);
+      return out;
+    }
     for (std::size_t t = 0; t < T; ++t)
       for (int c = 0; c < C; ++c) {
         double v = 0;
@@ -293,8 +351,17 @@ class SphereMapKernel {
   int resolution_ = 0;
   double kappa_ = 0;
   std::vector<glm::dvec3> centres_;  ///< texel centres (unit directions)
-  std::vector<std::uint32_t> offsets_, sources_;
-  std::vector<float> weights_;
+  std::vector<std::uint32_t> offsets_, sources_;       ///< per target: its sources (increasing), CSR
+  std::vector<float> weights_;                          ///< w_ts in that order
+  std::vector<std::uint32_t> scatter_offsets_, scatter_targets_;  ///< per source: its targets (increasing)
+  std::vector<float> scatter_weights_;                  ///< w_ts in that order
+
+  /// Whether texel s of a C-channel map holds anything to smooth.
+  static bool lit(const float* map, std::size_t s, int C) {
+    for (int c = 0; c < C; ++c)
+      if (map[s * std::size_t(C) + std::size_t(c)] != 0.0f) return true;
+    return false;
+  }
 };
 
 LUMX_NAMESPACE_END
