@@ -729,21 +729,17 @@ struct FitKernel {
 /// (SphereMapKernel::sharpening_gain: bias O(κ⁻²), so a spot's lobe keeps its peak) at σ = 0.75, 1.5 and 3
 /// texel widths; and local linear (SphereMapKernel::local_linear_gain: no leak across the border of the
 /// rays' support, such as a Lambertian emitter's horizon, where the others put most of their error) at
-/// σ = 1.5 and 3 texel widths. At R 128 the widest (3 texel widths) are left out: they are the angular
-/// width of R 64's 1.5, read through coarser texels at a quarter of the weights, and at R 128 they would
-/// hold 13·10⁶ weights each. R 128's kernels are for narrow lobes (a cos^50 spot read through R 64 texels
-/// is 11 % off at d = 10, and only finer texels with a kernel to average their noise do better: apl_sets.md).
+/// σ = 1.5 and 3 texel widths. R 128's kernels are for narrow lobes: a spot read through R 64 texels keeps
+/// their blur (a cos^20 spot's far field 4 % off, noise-free), and R 128 with a kernel as wide as R 64's
+/// averages the same noise through finer texels (apl_sets.md).
 inline std::vector<FitKernel> fit_kernels(int R) {
   std::vector<FitKernel> out;
   for (double kappa : fit_kernel_kappas(R)) out.push_back({kappa, KernelMode::plain});
   if (R < 32 || R > SphereMapKernel::kMaxResolution) return out;
   const double texel = std::sqrt(4.0 * kPi / (2.0 * double(R) * double(R)));
   const auto kappa_of = [&](double widths) { return 1.0 / ((widths * texel) * (widths * texel)); };
-  const double widest = R >= 128 ? 1.5 : 3.0;
-  for (double widths : {0.75, 1.5, 3.0})
-    if (widths <= widest) out.push_back({kappa_of(widths), KernelMode::sharpened});
-  for (double widths : {1.5, 3.0})
-    if (widths <= widest) out.push_back({kappa_of(widths), KernelMode::local_linear});
+  for (double widths : {0.75, 1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::sharpened});
+  for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::local_linear});
   return out;
 }
 

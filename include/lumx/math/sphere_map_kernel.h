@@ -66,8 +66,8 @@ inline void accumulate_channels(SphereMap& sum, const SphereMap& map) {
 class SphereMapKernel {
  public:
   /// Largest resolution the kernel is built for. Finding each texel's neighbours is a grid search (cost
-  /// ∝ the weights), so the limit is memory: at R 128 a kernel of σ = 1.5 texel widths holds 3.2·10⁶
-  /// weights (25 MB with both orders of them).
+  /// ∝ the weights), so the limit is memory: at R 128 a kernel of σ = 3 texel widths holds 1.3·10⁷
+  /// weights (100 MB).
   static constexpr int kMaxResolution = 128;
 
   /// The kernel for maps of resolution R (1..kMaxResolution) and concentration κ > 0 (1/rad²).
@@ -103,11 +103,13 @@ class SphereMapKernel {
       std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
       for (int t = 0; t < T; ++t) in_cell[fill[cell_index[std::size_t(t)]]++] = std::uint32_t(t);  // increasing t per cell
     }
-    // Per source (increasing): its targets (increasing) and normalised weights, kept in source order for
-    // the sparse scatter and gathered per target (CSR, sources increasing) for the dense apply.
-    std::vector<std::uint32_t> count_by_target(static_cast<std::size_t>(T), 0);
+    // Per source (increasing): its targets (increasing), its normalised weights and their normaliser. Only
+    // this order is stored: the neighbour relation is symmetric, so a target's sources are the targets of
+    // its own row, and their weights are recomputed from the centres and the normalisers when needed
+    // (local_linear_gain), to the same bits.
     std::vector<std::pair<std::uint32_t, double>> row;
-    scatter_offsets_.assign(std::size_t(T) + 1, 0);
+    offsets_.assign(std::size_t(T) + 1, 0);
+    normaliser_.assign(static_cast<std::size_t>(T), 0.0);
     for (int s = 0; s < T; ++s) {
       row.clear();
       const glm::dvec3& cs = centre[std::size_t(s)];
@@ -126,24 +128,13 @@ class SphereMapKernel {
       double sum = 0;
       for (const auto& entry : row) sum += entry.second;
       for (const auto& [t, w] : row) {
-        scatter_targets_.push_back(t);
-        scatter_weights_.push_back(float(w / sum));
-        ++count_by_target[t];
+        targets_.push_back(t);
+        weights_.push_back(float(w / sum));
       }
-      scatter_offsets_[std::size_t(s) + 1] = std::uint32_t(scatter_targets_.size());
+      normaliser_[std::size_t(s)] = sum;
+      offsets_[std::size_t(s) + 1] = std::uint32_t(targets_.size());
     }
     centres_ = std::move(centre);
-    offsets_.assign(std::size_t(T) + 1, 0);
-    for (int t = 0; t < T; ++t) offsets_[std::size_t(t) + 1] = offsets_[std::size_t(t)] + count_by_target[std::size_t(t)];
-    sources_.resize(offsets_.back());
-    weights_.resize(offsets_.back());
-    std::vector<std::uint32_t> next(offsets_.begin(), offsets_.end() - 1);
-    for (int s = 0; s < T; ++s)
-      for (std::uint32_t i = scatter_offsets_[std::size_t(s)]; i < scatter_offsets_[std::size_t(s) + 1]; ++i) {
-        const std::uint32_t at = next[scatter_targets_[i]]++;
-        sources_[at] = std::uint32_t(s);
-        weights_[at] = scatter_weights_[i];
-      }
   }
 
   /// The kernel for (R, κ) from a small process-wide cache (the last 8 built; thread-safe): building one
@@ -172,10 +163,10 @@ class SphereMapKernel {
 
   /// The smoothed map (same resolution and channels; flux kept). Throws for another resolution.
   ///
-  /// out_t = Σ_s w_ts in_s, summed in double over s in increasing order. A map with few lit texels (an
-  /// APL's map of a few thousand rays) is scattered from its lit sources only; a dense one is gathered per
-  /// target. Both add the same products in the same order (a skipped source adds 0), so the result is the
-  /// same bit for bit either way.
+  /// out_t = Σ_s w_ts in_s, summed in double over s in increasing order: each source texel that holds
+  /// anything is scattered to its targets, so a map with few lit texels (an APL's map of a few thousand
+  /// rays) costs only those; skipping an empty source skips adding 0, so the sums are those of a gather
+  /// over every source, bit for bit.
   SphereMap apply(const SphereMap& in) const {
     if (in.resolution() != resolution_)
       throw std::invalid_argument("SphereMapKernel: a map of resolution " + std::to_string(in.resolution()) +
@@ -183,30 +174,17 @@ class SphereMapKernel {
     const int C = in.channels();
     SphereMap out(resolution_, C);
     const float* src = in.data();
-    float* dst = out.data();
     const std::size_t T = offsets_.size() - 1;
-    std::size_t lit_weights = 0;
-    for (std::size_t s = 0; s < T; ++s)
-      if (lit(src, s, C)) lit_weights += scatter_offsets_[s + 1] - scatter_offsets_[s];
-    if (4 * lit_weights < weights_.size()) {
-      std::vector<double> sum(T * std::size_t(C), 0.0);
-      for (std::size_t s = 0; s < T; ++s) {
-        if (!lit(src, s, C)) continue;
-        for (std::uint32_t i = scatter_offsets_[s]; i < scatter_offsets_[s + 1]; ++i)
-          for (int c = 0; c < C; ++c)
-            sum[std::size_t(scatter_targets_[i]) * std::size_t(C) + std::size_t(c)] +=
-                double(scatter_weights_[i]) * double(src[s * std::size_t(C) + std::size_t(c)]);
-      }
-      for (std::size_t i = 0; i < sum.size(); ++i) dst[i] = float(sum[i]);
-      return out;
+    std::vector<double> sum(T * std::size_t(C), 0.0);
+    for (std::size_t s = 0; s < T; ++s) {
+      if (!lit(src, s, C)) continue;
+      for (std::uint32_t i = offsets_[s]; i < offsets_[s + 1]; ++i)
+        for (int c = 0; c < C; ++c)
+          sum[std::size_t(targets_[i]) * std::size_t(C) + std::size_t(c)] +=
+              double(weights_[i]) * double(src[s * std::size_t(C) + std::size_t(c)]);
     }
-    for (std::size_t t = 0; t < T; ++t)
-      for (int c = 0; c < C; ++c) {
-        double v = 0;
-        for (std::uint32_t i = offsets_[t]; i < offsets_[t + 1]; ++i)
-          v += double(weights_[i]) * double(src[std::size_t(sources_[i]) * std::size_t(C) + std::size_t(c)]);
-        dst[t * std::size_t(C) + std::size_t(c)] = float(v);
-      }
+    float* dst = out.data();
+    for (std::size_t i = 0; i < sum.size(); ++i) dst[i] = float(sum[i]);
     return out;
   }
 
@@ -303,11 +281,13 @@ class SphereMapKernel {
       const glm::dvec3 e2 = glm::cross(n, e1);
       // Normal equations of the weighted fit, in tangent coordinates relative to ω_t (so u, v ~ σ).
       double s0 = 0, su = 0, sv = 0, suu = 0, suv = 0, svv = 0, f0 = 0, fu = 0, fv = 0;
+      // Row t's sources are the targets of source t (a symmetric relation), in increasing order; w_ts as
+      // the constructor computed it.
       for (std::uint32_t i = offsets_[t]; i < offsets_[t + 1]; ++i) {
-        const std::size_t src = sources_[i];
+        const std::size_t src = targets_[i];
         const double f = double(sum.data()[src]);
         if (!(f > 0)) continue;
-        const double w = double(weights_[i]);
+        const double w = double(float(std::exp(-kappa_ * (1.0 - glm::dot(centres_[src], centres_[t]))) / normaliser_[src]));
         const double u = glm::dot(centres_[src], e1), v = glm::dot(centres_[src], e2);
         s0 += w, su += w * u, sv += w * v, suu += w * u * u, suv += w * u * v, svv += w * v * v;
         f0 += w * f, fu += w * u * f, fv += w * v * f;
@@ -351,10 +331,9 @@ class SphereMapKernel {
   int resolution_ = 0;
   double kappa_ = 0;
   std::vector<glm::dvec3> centres_;  ///< texel centres (unit directions)
-  std::vector<std::uint32_t> offsets_, sources_;       ///< per target: its sources (increasing), CSR
-  std::vector<float> weights_;                          ///< w_ts in that order
-  std::vector<std::uint32_t> scatter_offsets_, scatter_targets_;  ///< per source: its targets (increasing)
-  std::vector<float> scatter_weights_;                  ///< w_ts in that order
+  std::vector<std::uint32_t> offsets_, targets_;  ///< per source: its targets (increasing), CSR
+  std::vector<float> weights_;                    ///< w_ts in that order (each source's sum to 1)
+  std::vector<double> normaliser_;                ///< per source: Σ_t exp(κ(ω_t·ω_s − 1)) over its targets
 
   /// Whether texel s of a C-channel map holds anything to smooth.
   static bool lit(const float* map, std::size_t s, int C) {
