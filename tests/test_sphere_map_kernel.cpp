@@ -148,6 +148,8 @@ TEST(SphereMapKernel, RefusesBadArgumentsAndIsShared) {
   EXPECT_THROW(SphereMapKernel(SphereMapKernel::kMaxResolution * 2, 10), std::invalid_argument);
   EXPECT_THROW(SphereMapKernel(16, 0), std::invalid_argument);
   EXPECT_THROW(SphereMapKernel(16, NAN), std::invalid_argument);
+  // A kernel nearly as wide as the sphere at R 128 would hold 10⁹ weights: refused before allocating.
+  EXPECT_THROW(SphereMapKernel(SphereMapKernel::kMaxResolution, 0.5), std::invalid_argument);
   const SphereMapKernel k(16, 50);
   EXPECT_THROW(k.apply(SphereMap(8, 1)), std::invalid_argument);
   EXPECT_EQ(SphereMapKernel::shared(16, 50).get(), SphereMapKernel::shared(16, 50).get());

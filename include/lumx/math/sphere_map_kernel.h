@@ -69,6 +69,8 @@ class SphereMapKernel {
   /// ∝ the weights), so the limit is memory: at R 128 a kernel of σ = 3 texel widths holds 1.3·10⁷
   /// weights (100 MB).
   static constexpr int kMaxResolution = 128;
+  /// Most weights a kernel may hold (8 bytes each).
+  static constexpr std::size_t kMaxWeights = std::size_t(64) << 20;
 
   /// The kernel for maps of resolution R (1..kMaxResolution) and concentration κ > 0 (1/rad²).
   SphereMapKernel(int resolution, double kappa) : resolution_(resolution), kappa_(kappa) {
@@ -84,6 +86,12 @@ class SphereMapKernel {
         centre[std::size_t(y) * std::size_t(W) + std::size_t(x)] = glm::normalize(glm::dvec3(sphere_map::uv_to_direction(
             {(float(x) + 0.5f) / float(W), (float(y) + 0.5f) / float(resolution)})));
     const double cut = std::log(1e3) / kappa;  // 1 − cos of the truncation angle
+    // The cap 1 − ω·ω' ≤ cut is cut/2 of the sphere: refuse a kernel that would hold more weights than
+    // kMaxWeights rather than allocate them (a κ near 0 at R 128 would ask for 10⁹).
+    if (double(T) * double(T) * std::min(1.0, cut / 2.0) > double(kMaxWeights))
+      throw std::invalid_argument("SphereMapKernel: kappa " + std::to_string(kappa) + " at resolution " +
+                                  std::to_string(resolution) + " needs more than " + std::to_string(kMaxWeights) +
+                                  " weights; use a larger kappa or a lower resolution");
     // Neighbours by a uniform grid over the cube [−1, 1]³ whose cells are at least the truncation chord
     // √(2·cut) wide (|ω − ω'|² = 2(1 − ω·ω')), so every neighbour of a texel lies in the 27 cells around its
     // own. Each source's targets are then visited in increasing index, as a scan of all texels would, so
