@@ -69,6 +69,10 @@ class SphereMapKernel {
   /// ∝ the weights), so the limit is memory: at R 128 a kernel of σ = 3 texel widths holds 1.3·10⁷
   /// weights (100 MB).
   static constexpr int kMaxResolution = 128;
+  /// Kernels shared() keeps: more than the held-out fit uses (3 widths at each of R 32, 64 and 128: 9, about
+  /// 180 MB), since a cache that drops the oldest and is smaller than the cycle of a level's candidates
+  /// would rebuild every kernel for every level.
+  static constexpr std::size_t kCached = 12;
   /// Most weights a kernel may hold (8 bytes each).
   static constexpr std::size_t kMaxWeights = std::size_t(64) << 20;
 
@@ -145,7 +149,7 @@ class SphereMapKernel {
     centres_ = std::move(centre);
   }
 
-  /// The kernel for (R, κ) from a small process-wide cache (the last 8 built; thread-safe): building one
+  /// The kernel for (R, κ) from a small process-wide cache (the last kCached built; thread-safe): building one
   /// costs more than applying it to a few hundred maps.
   static std::shared_ptr<const SphereMapKernel> shared(int resolution, double kappa) {
     static std::mutex mutex;
@@ -157,7 +161,7 @@ class SphereMapKernel {
     }
     auto k = std::make_shared<const SphereMapKernel>(resolution, kappa);
     std::lock_guard<std::mutex> lock(mutex);
-    if (cache.size() >= 8) cache.erase(cache.begin());
+    if (cache.size() >= kCached) cache.erase(cache.begin());
     cache.push_back(k);
     return k;
   }
