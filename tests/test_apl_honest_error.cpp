@@ -681,8 +681,9 @@ namespace {
 // What limits the spots (docs/apl_sets.md): the shipped finest level (fitted on held-out rays as lumx build
 // does) from 1 M and 4 M rays, against the exact irradiance. Noise falls as 1/√N and, the kernel
 // narrowing as the rays allow, the error falls at least that fast where noise limits it; a bias stays.
-// Then, from the 1 M rays, the finest level with the R 128 kernel the fit chooses from 4 M rays (σ = 1.5
-// texel widths, sharpened), set by hand: what the fit misses at 1 M. Then the floor of maps at the spot's
+// Then, from the 1 M rays, the finest level at R 128 with σ = 1.5 texel widths, sharpened, set by hand:
+// what the fit chooses for the cos^50 spot from 4 M rays and misses at 1 M (for the cos^20 spot it
+// chooses σ = 3 texel widths at R 128 from both). Then the floor of maps at the spot's
 // centre: one APL whose map is the exact intensity averaged over each texel, at R 64 and 128. Printed, and
 // checked against the documented rows. Off by default (about 3 min):
 //   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*SpotStudy*'
