@@ -775,6 +775,36 @@ inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const
   return {(plain - smoothed) / plain, 2.0 / std::sqrt(std::max(1.0, rays_there))};
 }
 
+/// The standard error of the difference of two candidates' Σ_d log ε(d) (fit_map_resolutions), from their
+/// model values `a` and `b` per sphere and patch against the same reference. On sphere s, ε² = mean_p r_p² / m²
+/// (r the residual, m the reference's mean), so log ε_a − log ε_b ≈ mean_p δ_p / (2 m² ε̄²) with
+/// δ_p = r_a,p² − r_b,p² and ε̄² the mean of the two ε²; its variance is var_p(δ) / N over that square. The
+/// shared reference's noise cancels in δ to first order, which is what makes two candidates comparable
+/// far below the noise floor; the spheres are summed as independent. Spheres where either error is not
+/// finite and positive are left out, as in the cost.
+inline double cost_difference_standard_error(const ReferenceIrradiance& ref, const std::vector<std::vector<double>>& a,
+                                             const std::vector<std::vector<double>>& b) {
+  double variance = 0;
+  for (std::size_t s = 0; s < ref.sphere.size() && s < a.size() && s < b.size(); ++s) {
+    const std::vector<double>& e = ref.sphere[s].irradiance;
+    const std::size_t n = e.size();
+    if (n < 2 || a[s].size() != n || b[s].size() != n) continue;
+    double mean_ref = 0, sa = 0, sb = 0, sd = 0, sdd = 0;
+    for (std::size_t p = 0; p < n; ++p) {
+      const double ra = (a[s][p] - e[p]) * (a[s][p] - e[p]), rb = (b[s][p] - e[p]) * (b[s][p] - e[p]);
+      mean_ref += e[p];
+      sa += ra, sb += rb, sd += ra - rb, sdd += (ra - rb) * (ra - rb);
+    }
+    mean_ref /= double(n);
+    const double m2 = mean_ref * mean_ref, ea2 = sa / double(n) / m2, eb2 = sb / double(n) / m2;
+    if (!(ea2 > 0) || !(eb2 > 0) || !std::isfinite(ea2 + eb2)) continue;
+    const double mean_d = sd / double(n), var_d = std::max(0.0, sdd / double(n) - mean_d * mean_d) * double(n) / double(n - 1);
+    const double scale = 2 * m2 * 0.5 * (ea2 + eb2);
+    variance += var_d / double(n) / (scale * scale);
+  }
+  return std::sqrt(variance);
+}
+
 /// The error beyond which the kernel guard of fit_map_resolutions does not protect a distance (relative RMSE).
 inline constexpr double kUnusableError = 0.25;
 
@@ -791,8 +821,13 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     const AplLevel built = set.levels[k];
     std::vector<FitCandidate> tried;
     FitCandidate best{built.map_resolution, 0.0, INFINITY};
+    // Every eligible candidate (past the kernel guards) with its model values, for the one-standard-error
+    // rule below.
+    std::vector<std::pair<FitCandidate, std::vector<std::vector<double>>>> eligible;
+    std::vector<std::vector<double>> last_values;
     const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
-      const LevelErrors row = evaluate_level(set, k, ref, o);
+      LevelErrors row = evaluate_level(set, k, ref, o);
+      last_values = std::move(row.irradiance);
       double cost = 0;
       errors.clear();
       for (const IrradianceErrors& e : row.errors) {
@@ -809,6 +844,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       set.levels[k] = at_r;
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       if (plain < best.cost) best = tried.back();
+      eligible.emplace_back(tried.back(), std::move(last_values));
       for (const FitKernel& kernel : set_rays > 0 ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where
@@ -828,12 +864,32 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         for (std::size_t s = 0; s < kernel_errors.size() && s < plain_errors.size(); ++s)
           if (std::isfinite(plain_errors[s]) && plain_errors[s] <= kUnusableError && !(kernel_errors[s] <= plain_errors[s]))
             no_worse = false;
+        if (no_worse) eligible.emplace_back(tried.back(), std::move(last_values));
         if (no_worse && cost < best.cost) best = tried.back();
       }
       // Past the minimum: coarser maps trade noise for blur, and once halving made them worse and the best
       // so far is better still, further halving only blurs more (the error is U-shaped in R).
       if (R % 2 != 0 || (plain > plain_before && best.cost < plain)) break;
       plain_before = plain;
+    }
+    // One-standard-error rule (Breiman et al. 1984 §3.4.3; Hastie et al., ESL §7.10): the coarsest
+    // resolution with a candidate whose cost is within one standard error of the best's
+    // (cost_difference_standard_error), and its best candidate there. Finer maps cost four times the
+    // bytes and memory per halving; where the held-out rays cannot tell them apart (an LED strip's middle
+    // levels: R 128, 64 and 32 within 0.005 of each other) they are not worth it.
+    {
+      const std::vector<std::vector<double>>* best_values = nullptr;
+      for (const auto& [c, values] : eligible)
+        if (c.resolution == best.resolution && c.kappa == best.kappa && c.mode == best.mode) best_values = &values;
+      if (best_values) {
+        FitCandidate simpler = best;
+        for (const auto& [c, values] : eligible) {
+          if (c.resolution > simpler.resolution) continue;
+          if (!(c.cost <= best.cost + cost_difference_standard_error(ref, *best_values, values))) continue;
+          if (c.resolution < simpler.resolution || c.cost < simpler.cost) simpler = c;
+        }
+        best = simpler;
+      }
     }
     set.levels[k] = downsampled_level(built, best.resolution);
     if (best.kappa > 0)
