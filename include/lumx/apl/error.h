@@ -616,10 +616,12 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
 // query sees it; coarser texels trade that noise for blur. Which wins depends on the luminaire, the level
 // and the ray count, so it is measured: each level's maps are box-downsampled (flux-exact on equal-area
 // maps) by halving from the built resolution, every candidate is graded at the points of the
-// measurement spheres against held-out rays, and the one with the least Σ_d log ε(d) (the geometric mean
-// over the distances, so that each distance counts by its relative change: a one-APL level is hopeless
-// near a spot whatever its maps, and a plain sum would let that decide its far field) is kept. (The
-// noise variance of the reference is the same for every candidate, so the raw ε ranks them.) The
+// measurement spheres against held-out rays moved to the patch centres (centred_reference), and the one
+// with the least Σ_d log ε(d) (the geometric mean over the distances, so that each distance counts by its
+// relative change: a one-APL level is hopeless near a spot whatever its maps, and a plain sum would let
+// that decide its far field) is the best; the coarsest resolution with a candidate within one standard
+// error of it is kept (the one-standard-error rule in fit_map_resolutions). (The noise variance of the
+// reference is the same for every candidate, so the raw ε ranks them.) The
 // choice is made on a set built from half the rays; a set from all of them has half the noise variance
 // and might afford one step finer — the choice is the conservative one.
 
@@ -778,32 +780,49 @@ inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const
 /// The standard error of the difference of two candidates' Σ_d log ε(d) (fit_map_resolutions), from their
 /// model values `a` and `b` per sphere and patch against the same reference. On sphere s, ε² = mean_p r_p² / m²
 /// (r the residual, m the reference's mean), so log ε_a − log ε_b ≈ mean_p δ_p / (2 m² ε̄²) with
-/// δ_p = r_a,p² − r_b,p² and ε̄² the mean of the two ε²; its variance is var_p(δ) / N over that square. The
-/// shared reference's noise cancels in δ to first order, which is what makes two candidates comparable
-/// far below the noise floor; the spheres are summed as independent. Spheres where either error is not
-/// finite and positive are left out, as in the cost.
+/// δ_p = r_a,p² − r_b,p² and ε̄² the mean of the two ε². With the reference E = E_true + η,
+/// δ_p = (a − b)(a + b − 2E_true) − 2(a − b)η: the noise variance η² cancels and what remains of the noise
+/// scales with the candidates' difference, which is what lets two candidates be told apart far below the
+/// noise floor. The spheres share their patch layout and the same rays cross matching patches of every
+/// sphere, so the terms are summed over the spheres per patch and the variance taken of that sum over the
+/// N patches: var_p(Σ_s δ_s,p / (2 m_s² ε̄_s²)) / N. Spheres where either error is not finite and positive
+/// are left out, as in the cost; so are spheres whose patch count differs from the first's.
 inline double cost_difference_standard_error(const ReferenceIrradiance& ref, const std::vector<std::vector<double>>& a,
                                              const std::vector<std::vector<double>>& b) {
-  double variance = 0;
+  std::vector<double> per_patch;
   for (std::size_t s = 0; s < ref.sphere.size() && s < a.size() && s < b.size(); ++s) {
     const std::vector<double>& e = ref.sphere[s].irradiance;
     const std::size_t n = e.size();
     if (n < 2 || a[s].size() != n || b[s].size() != n) continue;
-    double mean_ref = 0, sa = 0, sb = 0, sd = 0, sdd = 0;
+    if (per_patch.empty()) per_patch.assign(n, 0.0);
+    if (per_patch.size() != n) continue;
+    double mean_ref = 0, sa = 0, sb = 0;
     for (std::size_t p = 0; p < n; ++p) {
-      const double ra = (a[s][p] - e[p]) * (a[s][p] - e[p]), rb = (b[s][p] - e[p]) * (b[s][p] - e[p]);
       mean_ref += e[p];
-      sa += ra, sb += rb, sd += ra - rb, sdd += (ra - rb) * (ra - rb);
+      sa += (a[s][p] - e[p]) * (a[s][p] - e[p]);
+      sb += (b[s][p] - e[p]) * (b[s][p] - e[p]);
     }
     mean_ref /= double(n);
     const double m2 = mean_ref * mean_ref, ea2 = sa / double(n) / m2, eb2 = sb / double(n) / m2;
     if (!(ea2 > 0) || !(eb2 > 0) || !std::isfinite(ea2 + eb2)) continue;
-    const double mean_d = sd / double(n), var_d = std::max(0.0, sdd / double(n) - mean_d * mean_d) * double(n) / double(n - 1);
     const double scale = 2 * m2 * 0.5 * (ea2 + eb2);
-    variance += var_d / double(n) / (scale * scale);
+    for (std::size_t p = 0; p < n; ++p) {
+      const double ra = (a[s][p] - e[p]) * (a[s][p] - e[p]), rb = (b[s][p] - e[p]) * (b[s][p] - e[p]);
+      per_patch[p] += (ra - rb) / scale;
+    }
   }
-  return std::sqrt(variance);
+  const std::size_t n = per_patch.size();
+  if (n < 2) return 0.0;
+  double mean = 0, sq = 0;
+  for (double d : per_patch) mean += d / double(n);
+  for (double d : per_patch) sq += (d - mean) * (d - mean);
+  return std::sqrt(sq / double(n - 1) / double(n));
 }
+
+/// The map bytes (in memory) above which fit_map_resolutions trades a level's finer maps for coarser ones
+/// the held-out rays cannot tell apart from them (the one-standard-error rule): 1 MiB, an eighth of the
+/// 8 MiB a 512-APL bundle from 1 M rays is given.
+inline constexpr double kParsimonyBytes = 1024.0 * 1024.0;
 
 /// The error beyond which the kernel guard of fit_map_resolutions does not protect a distance (relative RMSE).
 inline constexpr double kUnusableError = 0.25;
@@ -847,15 +866,16 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       eligible.emplace_back(tried.back(), std::move(last_values));
       for (const FitKernel& kernel : set_rays > 0 ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
-        // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where
-        // the fit's patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7°
-        // lowered the peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10).
+        // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where a
+        // patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7° lowered the
+        // peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10). Kept with the
+        // centred reference, which is only as sharp as its pilot.
         const auto [lowering, allowance] = kernel_peak_change(at_r, *kernel_for(R, kappa), set_rays, kernel.mode);
         if (lowering > allowance) continue;
         set.levels[k] = smoothed_level(at_r, *kernel_for(R, kappa), 0, kernel.mode);
         const double cost = grade(R, kappa, kernel.mode, kernel_errors);
         // A kernel must not give away any distance against the same maps unsmoothed: its bias is largest at
-        // a narrow peak, which the fit's patches (coarser than the peak) see only in part, at some distances
+        // a narrow peak, which patches coarser than the peak see only in part, at some distances
         // (a cos^50 spot: σ 1.7° won the geometric mean by the near field and doubled the error at d ≥ 5).
         // Distances where the level is off by more than 25 % unsmoothed are not protected: no error target
         // uses it there (a one-APL level near a spot: 340 % either way), and a sharper far field, right at
@@ -877,7 +897,12 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     // (cost_difference_standard_error), and its best candidate there. Finer maps cost four times the
     // bytes and memory per halving; where the held-out rays cannot tell them apart (an LED strip's middle
     // levels: R 128, 64 and 32 within 0.005 of each other) they are not worth it.
-    {
+    // The rule is for bytes, so a level whose maps hold at most kParsimonyBytes at the best's resolution
+    // keeps the best: that the held-out rays cannot tell two candidates apart is no evidence that the
+    // coarser is as good (a cos^20 spot's 8-APL level: R 64 within one standard error of R 128, and 4.3 %
+    // off at d = 10 against 3.1 %).
+    const double scale = double(best.resolution) / double(std::max(1, built.map_resolution));
+    if (double(built.map_bytes()) * scale * scale > kParsimonyBytes) {
       const std::vector<std::vector<double>>* best_values = nullptr;
       for (const auto& [c, values] : eligible)
         if (c.resolution == best.resolution && c.kappa == best.kappa && c.mode == best.mode) best_values = &values;
@@ -928,17 +953,23 @@ inline AplSet centring_pilot(const AplSet& set) {
 /// candidates: E_c = max(0, E + P(centre) − P̄), with P a pilot model (level 0 of `pilot`, e.g.
 /// centring_pilot of a set built from other rays) and P̄ its mean over the patch (k × k sub-points).
 /// Why: a patch mean sits below a narrow lobe's peak and above its foot. A cos^50 spot's exact patch means on
-/// R 32 patches are 24 % (eq. 5.1) from its values at the patch centres at d = 10, five times the error of a
+/// R 32 patches are 26 % (eq. 5.1) from its values at the patch centres at d = 10, five times the error of a
 /// good level, so the fit preferred candidates blurred like a patch: it kept R 64 for the finest level of
 /// that spot (11.3 % off at d = 10 against the exact irradiance; R 128, chosen against centred references,
 /// 4.4 %). A 5-point Laplacian of the patch means (the second-order correction) removed only half of the
 /// bias (24 → 14 % with 4 M rays): at h/σ ≈ 0.5 the higher orders are as large. Centred by the pilot, the
 /// reference is within 1.15× its noise floor of the exact centre values (tests/test_apl_honest_error.cpp,
-/// FitReference). The pilot's shape within a patch is the same for every candidate, so each candidate's own
-/// point noise is still seen in full; what remains is the pilot's error in that shape. The variance and
-/// halves are left as they are.
+/// FitReference). The pilot's shape within a patch is the same for every candidate and, made from other
+/// rays, independent of them, so each candidate's own point noise is still seen in full; what remains is
+/// the pilot's error in that shape. The variance and
+/// halves are left as they are; a patch the centring would take below 0 is set to 0 (irradiance is never
+/// negative), which can lift a dark patch by a little. The pilot must not share rays with the candidates
+/// (evaluate_held_out_fitted builds it from the fitting rays): a pilot made from a candidate's own rays
+/// would cancel that candidate's noise within each patch, and the fit would favour whatever resembles
+/// it. Throws std::invalid_argument unless 2 ≤ k ≤ 16.
 inline ReferenceIrradiance centred_reference(const ReferenceIrradiance& ref, const AplSet& pilot,
                                              const AplErrorOptions& options, int k = 4) {
+  if (k < 2 || k > 16) throw std::invalid_argument("centred_reference: k must be in [2, 16]");
   ReferenceIrradiance out = ref;
   AplErrorOptions o = options;
   o.min_timing_seconds = 0;
@@ -993,9 +1024,11 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
     quiet.patch_resolution = fit_patch_resolution(options.patch_resolution, fit.info().ray_count);
     AplSet far = set;
     far.levels.resize(1);
-    // Both fit references at the patch centres (centred_reference), by the shape of a pilot from the
-    // training rays.
-    const AplSet pilot = centring_pilot(set);
+    // The fit grades single points (a renderer's queries), whatever the report averages.
+    quiet.patch_subsamples = 1;
+    // Both fit references at the patch centres (centred_reference), by the shape of a pilot made from the
+    // fitting rays: independent of the candidates (built from the even rays), so it cannot favour one.
+    const AplSet pilot = centring_pilot(build(static_cast<RaySource&>(fit)));
     const ReferenceIrradiance fit_ref = centred_reference(gather_reference(fit, set.bounds, quiet), pilot, quiet);
     c = fit_map_resolutions(set, fit_ref, quiet, min_resolution, train_rays);
     AplErrorOptions far_options = quiet;
