@@ -841,9 +841,14 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     std::vector<FitCandidate> tried;
     FitCandidate best{built.map_resolution, 0.0, INFINITY};
     // Every eligible candidate (past the kernel guards) with its model values, for the one-standard-error
-    // rule below.
+    // rule below; the best is one of them.
     std::vector<std::pair<FitCandidate, std::vector<std::vector<double>>>> eligible;
-    std::vector<std::vector<double>> last_values;
+    std::vector<std::vector<double>> last_values;  // the model values of the candidate graded last
+    std::size_t best_at = 0;
+    const auto admit = [&]() {
+      eligible.emplace_back(tried.back(), std::move(last_values));
+      if (tried.back().cost < best.cost) best = tried.back(), best_at = eligible.size() - 1;
+    };
     const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
       LevelErrors row = evaluate_level(set, k, ref, o);
       last_values = std::move(row.irradiance);
@@ -862,8 +867,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       const AplLevel at_r = downsampled_level(built, R);
       set.levels[k] = at_r;
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
-      if (plain < best.cost) best = tried.back();
-      eligible.emplace_back(tried.back(), std::move(last_values));
+      admit();
       for (const FitKernel& kernel : set_rays > 0 ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where a
@@ -873,7 +877,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         const auto [lowering, allowance] = kernel_peak_change(at_r, *kernel_for(R, kappa), set_rays, kernel.mode);
         if (lowering > allowance) continue;
         set.levels[k] = smoothed_level(at_r, *kernel_for(R, kappa), 0, kernel.mode);
-        const double cost = grade(R, kappa, kernel.mode, kernel_errors);
+        grade(R, kappa, kernel.mode, kernel_errors);
         // A kernel must not give away any distance against the same maps unsmoothed: its bias is largest at
         // a narrow peak, which patches coarser than the peak see only in part, at some distances
         // (a cos^50 spot: σ 1.7° won the geometric mean by the near field and doubled the error at d ≥ 5).
@@ -884,8 +888,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         for (std::size_t s = 0; s < kernel_errors.size() && s < plain_errors.size(); ++s)
           if (std::isfinite(plain_errors[s]) && plain_errors[s] <= kUnusableError && !(kernel_errors[s] <= plain_errors[s]))
             no_worse = false;
-        if (no_worse) eligible.emplace_back(tried.back(), std::move(last_values));
-        if (no_worse && cost < best.cost) best = tried.back();
+        if (no_worse) admit();
       }
       // Past the minimum: coarser maps trade noise for blur, and once halving made them worse and the best
       // so far is better still, further halving only blurs more (the error is U-shaped in R).
@@ -896,25 +899,21 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     // resolution with a candidate whose cost is within one standard error of the best's
     // (cost_difference_standard_error), and its best candidate there. Finer maps cost four times the
     // bytes and memory per halving; where the held-out rays cannot tell them apart (an LED strip's middle
-    // levels: R 128, 64 and 32 within 0.005 of each other) they are not worth it.
+    // levels) they are not worth it.
     // The rule is for bytes, so a level whose maps hold at most kParsimonyBytes at the best's resolution
     // keeps the best: that the held-out rays cannot tell two candidates apart is no evidence that the
-    // coarser is as good (a cos^20 spot's 8-APL level: R 64 within one standard error of R 128, and 4.3 %
-    // off at d = 10 against 3.1 %).
+    // coarser is as good (in a trial applying the rule to every level, a cos^20 spot's 8-APL level went to
+    // R 64 and was 4.3 % off at d = 10 against 3.1 %; the suite's far-field test refused it).
     const double scale = double(best.resolution) / double(std::max(1, built.map_resolution));
-    if (double(built.map_bytes()) * scale * scale > kParsimonyBytes) {
-      const std::vector<std::vector<double>>* best_values = nullptr;
-      for (const auto& [c, values] : eligible)
-        if (c.resolution == best.resolution && c.kappa == best.kappa && c.mode == best.mode) best_values = &values;
-      if (best_values) {
-        FitCandidate simpler = best;
-        for (const auto& [c, values] : eligible) {
-          if (c.resolution > simpler.resolution) continue;
-          if (!(c.cost <= best.cost + cost_difference_standard_error(ref, *best_values, values))) continue;
-          if (c.resolution < simpler.resolution || c.cost < simpler.cost) simpler = c;
-        }
-        best = simpler;
+    if (!eligible.empty() && double(built.map_bytes()) * scale * scale > kParsimonyBytes) {
+      const std::vector<std::vector<double>>& best_values = eligible[best_at].second;
+      FitCandidate simpler = best;
+      for (const auto& [c, values] : eligible) {
+        if (c.resolution > simpler.resolution) continue;
+        if (!(c.cost <= best.cost + cost_difference_standard_error(ref, best_values, values))) continue;
+        if (c.resolution < simpler.resolution || c.cost < simpler.cost) simpler = c;
       }
+      best = simpler;
     }
     set.levels[k] = downsampled_level(built, best.resolution);
     if (best.kappa > 0)
@@ -938,8 +937,12 @@ inline AplSet centring_pilot(const AplSet& set) {
     if (std::abs(std::log(double(std::max<std::size_t>(1, set.levels[k].size())) / 64.0)) <
         std::abs(std::log(double(std::max<std::size_t>(1, set.levels[best].size())) / 64.0)))
       best = k;
-  AplSet pilot = set;
-  pilot.levels.assign(1, set.levels[best]);
+  AplSet pilot;  // the set's metadata and that one level, without copying the others' maps
+  pilot.quantity = set.quantity;
+  pilot.channels = set.channels;
+  pilot.bounds = set.bounds;
+  pilot.provenance = set.provenance;
+  pilot.levels.push_back(set.levels[best]);
   const int R = pilot.levels[0].map_resolution;
   if (R >= 32 && R <= SphereMapKernel::kMaxResolution) {
     const double texel = std::sqrt(4.0 * kPi / (2.0 * double(R) * double(R)));
@@ -956,8 +959,8 @@ inline AplSet centring_pilot(const AplSet& set) {
 /// R 32 patches are 26 % (eq. 5.1) from its values at the patch centres at d = 10, five times the error of a
 /// good level, so the fit preferred candidates blurred like a patch: it kept R 64 for the finest level of
 /// that spot (11.3 % off at d = 10 against the exact irradiance; R 128, chosen against centred references,
-/// 4.4 %). A 5-point Laplacian of the patch means (the second-order correction) removed only half of the
-/// bias (24 → 14 % with 4 M rays): at h/σ ≈ 0.5 the higher orders are as large. Centred by the pilot, the
+/// 4.4 %). A 5-point Laplacian of the patch means (the second-order correction), tried and not kept,
+/// removed only half of the bias (24 → 14 % with 4 M rays): at h/σ ≈ 0.5 the higher orders are as large. Centred by the pilot, the
 /// reference is within 1.15× its noise floor of the exact centre values (tests/test_apl_honest_error.cpp,
 /// FitReference). The pilot's shape within a patch is the same for every candidate and, made from other
 /// rays, independent of them, so each candidate's own point noise is still seen in full; what remains is
