@@ -40,7 +40,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <thread>
 #include <string>
 #include <utility>
@@ -210,7 +209,23 @@ std::string table_text(const lumx::AplErrorReport& r, const std::string& bundle,
   for (const lumx::LevelErrors* row : rows) averaged = averaged || row->subsamples > 1;
   const std::string where = averaged ? "irradiance averaged over k x k points per patch (hides texel noise)"
                                      : "irradiance at a point (the patch centre)";
-  const std::string t0 = "relative RMSE (eq. 5.1) of " + where + ", % of the mean, at relative distance d;\n" +
+  // Which spheres' reference is at the patch centres (lumx::checked_centred_reference) and which keeps
+  // the patch means: each row's errors are against that.
+  std::string centred, means;
+  for (const lumx::SphereReference& sr : ref.sphere) {
+    char d[32];
+    std::snprintf(d, sizeof d, "%s%.4g", (sr.centred ? centred : means).empty() ? "" : ", ", sr.relative_distance);
+    (sr.centred ? centred : means) += d;
+  }
+  std::string against;
+  if (!centred.empty())
+    against += "against the rays' irradiance at the patch centres (patch means moved by a pilot's shape) at d = " +
+               centred + ";\n";
+  if (!means.empty())
+    against += "against the rays' mean irradiance over each patch at d = " + means +
+               (centred.empty() ? ";\n" : " (a pilot's shape there failed the rays' own);\n");
+  const std::string t0 = "relative RMSE (eq. 5.1) of " + where + ", % of the mean, at relative distance d,\n" +
+                         against +
                          "rays not used to build the levels, their noise removed ('<': below what these rays resolve)";
   const std::string t1 = "the same with the rays' noise left in, and the noise floor (what an exact model would show)";
   const char* titles[4] = {t0.c_str(), t1.c_str(), "Hellinger distance of the normalised patch distributions, at d",
@@ -309,6 +324,9 @@ json report_json(const lumx::AplErrorReport& r, const EvalArgs& a, lumx::Photome
                        {"radius_m", sr.radius},
                        {"noise_floor", sr.noise_floor},
                        {"split_noise_floor", sr.split_noise_floor},
+                       {"reference", sr.centred ? "patch centres" : "patch means"},
+                       {"centring_shift", std::isfinite(sr.centring_shift) ? json(sr.centring_shift) : json()},
+                       {"pilot_shape_error", std::isfinite(sr.pilot_shape_error) ? json(sr.pilot_shape_error) : json()},
                        {"rays", sr.rays},
                        {"started_outside", sr.started_outside},
                        {"missed", sr.missed}});
@@ -500,6 +518,17 @@ int run_rays(const EvalArgs& a) {
                                    : lumx::evaluate_held_out_fitted(*rays, build_half, o);
     graded += " (its levels rebuilt from the even rays)";
     against += " (the odd rays)";
+  } else if (o.patch_subsamples == 1) {
+    // The pilot that centres the reference: one level of 64 APLs from the even rays, built as the bundle
+    // records (lumx::evaluate_independent); the levels are graded on the odd rays.
+    const auto opts = set.provenance.find("build_options");
+    lumx::AplBuildOptions bo = opts != set.provenance.end() ? lumx::build_options_from_json(opts->second)
+                                                            : lumx::AplBuildOptions{};
+    bo.level_counts = {64};
+    bo.threads = std::max(1u, std::thread::hardware_concurrency());
+    report = lumx::evaluate_independent(set, *rays, [&](lumx::RaySource& r) { return lumx::build_apl_set(r, bo); }, o);
+    against += " (the odd rays; the even ones make the pilot that centres the reference)";
+    if (is_source) against += " (the rays it was built from: errors shared with them cancel)";
   } else {
     report = lumx::evaluate_apl_errors(set, *rays, o);
     if (is_source) against += " (the rays it was built from: errors shared with them cancel)";

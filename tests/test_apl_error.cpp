@@ -542,6 +542,8 @@ AplErrorReport expect_noise_floor_targets(RaySource& rays, double step_tolerance
   }
   std::printf("  noise floor    :");
   for (const SphereReference& sr : r.reference.sphere) std::printf(" %6.2f ", 100 * sr.noise_floor);
+  std::printf("\n  reference      :");
+  for (const SphereReference& sr : r.reference.sphere) std::printf(" %7s", sr.centred ? "centre" : "mean");
   std::printf("\n");
   for (std::size_t s = 0; s < r.reference.sphere.size(); ++s) {
     const double d = r.reference.sphere[s].relative_distance, noise = r.reference.sphere[s].noise_floor;

@@ -184,7 +184,7 @@ TEST(CliEval, RaysReportTableJsonPlotsAndStoredTables) {
                        " --plot-format svg --distances 0.5,1,5");
   ASSERT_EQ(t.status, 0) << t.out;
   for (const char* s : {"relative RMSE (eq. 5.1)", "noise floor", "far field", "ns/point", "bytes", "Hellinger",
-                        "40000 rays", "512 patches"})
+                        "20000 rays", "the even ones make the pilot", "512 patches"})
     EXPECT_NE(t.out.find(s), std::string::npos) << s << "\n" << t.out;
   for (const char* f : {"error_vs_distance.svg", "error_vs_time.svg", "error_vs_bytes.svg"}) {
     ASSERT_TRUE(fs::exists(plots / f)) << f;
@@ -201,10 +201,20 @@ TEST(CliEval, RaysReportTableJsonPlotsAndStoredTables) {
   AplErrorOptions o;
   o.patch_resolution = 8;
   o.min_timing_seconds = 0;
-  const AplErrorReport r = evaluate_apl_errors(set, *src, o);
+  // As the CLI grades rays from another run: the pilot (one level of 64 APLs, built as the bundle records)
+  // from the even rays, the levels graded on the odd ones.
+  AplBuildOptions pilot_options;  // the fixture's bundle records no build options: the defaults
+  ASSERT_EQ(set.provenance.count("build_options"), 0u);
+  pilot_options.level_counts = {64};
+  const auto build_pilot = [&](RaySource& r) { return build_apl_set(r, pilot_options); };
+  const AplErrorReport r = evaluate_independent(set, *src, build_pilot, o);
   ASSERT_EQ(doc["levels"].size(), 3u);
   EXPECT_EQ(doc["patches"], 128);
-  EXPECT_EQ(doc["ray_count"], 40000);
+  EXPECT_EQ(doc["ray_count"], 20000);
+  for (std::size_t s = 0; s < 6; ++s) {
+    EXPECT_EQ(doc["spheres"][s]["reference"], r.reference.sphere[s].centred ? "patch centres" : "patch means");
+    EXPECT_EQ(doc["spheres"][s]["centring_shift"].get<double>(), r.reference.sphere[s].centring_shift);
+  }
   for (std::size_t k = 0; k < 3; ++k)
     for (std::size_t s = 0; s < 6; ++s) {
       EXPECT_EQ(doc["levels"][k]["relative_rmse"][s].get<double>(), r.levels[k].errors[s].relative_rmse);
@@ -226,7 +236,7 @@ TEST(CliEval, RaysReportTableJsonPlotsAndStoredTables) {
   EXPECT_TRUE(check_bundle(fx.bundle.string()).empty());
   const BundleReader stored(fx.bundle.string());
   o.patch_resolution = 16;
-  const AplErrorReport r16 = evaluate_apl_errors(set, *src, o);
+  const AplErrorReport r16 = evaluate_independent(set, *src, build_pilot, o);
   for (std::size_t k = 0; k < 3; ++k) {
     const ErrorTable& e = stored.manifest().levels[k].error;
     ASSERT_EQ(e.relative_distance, (std::vector<double>{0.5, 0.75, 1, 2, 5, 10}));
@@ -235,7 +245,7 @@ TEST(CliEval, RaysReportTableJsonPlotsAndStoredTables) {
       EXPECT_EQ(e.relative_rmse[s], x.resolved ? x.relative_rmse_noise_removed : x.noise_removed_upper);
     }
   }
-  EXPECT_NE(stored.manifest().provenance.at("error_tables").find("40000 rays"), std::string::npos);
+  EXPECT_NE(stored.manifest().provenance.at("error_tables").find("20000 rays"), std::string::npos);
   for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(stored.manifest().levels[k].maps.size(), stored_maps[k]) << k;
   // The maps themselves are rewritten losslessly.
   const AplSet after = stored.load();
