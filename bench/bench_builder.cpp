@@ -7,7 +7,7 @@
 //   cluster_tree/N   PLOC tree over N seeds (eq. 4.1) and the 1/8/64/256/512 cuts; N = 62.5 k … 1 M shows
 //                    the scaling (targets: 250 k < 5 s, 1 M < 20 s on one core)
 //   build/N/T        build_apl_set over N synthetic rays (250 k seeds, levels 1…512) with T assignment
-//                    threads, then write_bundle; 10 M rays on 2 threads is the issue's "< 60 s" target.
+//                    threads, then write_bundle; 10 M rays on 2 threads has a "< 60 s" target.
 //                    peak_rss_MiB is the process's high-water mark (the 10 M rays themselves are 280 MB).
 //   read_tm25/N      stream an N-ray TM-25 file (written first) from the page cache: throughput, memory
 //   build_file/N/T   what `lumx build FILE OUT --threads T` does on an N-ray TM-25 file, by phase
@@ -151,7 +151,7 @@ BENCHMARK(read_tm25)->Arg(10000000)->Unit(benchmark::kMillisecond)->Iterations(3
 /// What `lumx build FILE OUT --threads T` does (build_bundle, io/bundle_builder.h), on an N-ray TM-25 file
 /// written first: stream the file, build the levels, the held-out fit of every level's maps (resolution and
 /// kernel) and its error tables, the far field as IES and LDT from level 0's fitted maps, and write the
-/// bundle; each phase's seconds and the bundle's bytes (issue targets: 1 M rays ≤ 30 s, 10 M ≤ 90 s, the
+/// bundle; each phase's seconds and the bundle's bytes (targets: 1 M rays ≤ 30 s, 10 M ≤ 90 s, the
 /// 1 M-ray bundle ≤ 8 MiB). Run it alone (--benchmark_filter=build_file) for a meaningful peak_rss_MiB: the
 /// in-memory benchmarks above raise the process's high-water mark.
 void build_file(benchmark::State& state) {

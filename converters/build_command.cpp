@@ -116,7 +116,7 @@ void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lu
   if (r.evaluated)
     std::cout << "\n"
               << format_error_table(r.held_out.report, a.out + " (its levels rebuilt from the even rays)",
-                                    a.rays + " (the odd rays)", r.held_out.report.reference.quantity);
+                                    a.rays + " (odd rays the levels never saw)", r.held_out.report.reference.quantity);
 }
 
 }  // namespace lumx_cli

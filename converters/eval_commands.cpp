@@ -40,6 +40,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <thread>
 #include <string>
 #include <utility>
@@ -517,8 +518,8 @@ int run_rays(const EvalArgs& a) {
     report = bo.map_resolution > 0 ? lumx::evaluate_held_out(*rays, build_half, o)
                                    : lumx::evaluate_held_out_fitted(*rays, build_half, o);
     graded += " (its levels rebuilt from the even rays)";
-    against += " (the odd rays)";
-  } else if (o.patch_subsamples == 1) {
+    against += " (odd rays the levels never saw)";
+  } else if (!is_source && lumx::centring_applies(o)) {
     // The pilot that centres the reference: one level of 64 APLs from the even rays, built as the bundle
     // records (lumx::evaluate_independent); the levels are graded on the odd rays.
     const auto opts = set.provenance.find("build_options");
@@ -528,8 +529,8 @@ int run_rays(const EvalArgs& a) {
     bo.threads = std::max(1u, std::thread::hardware_concurrency());
     report = lumx::evaluate_independent(set, *rays, [&](lumx::RaySource& r) { return lumx::build_apl_set(r, bo); }, o);
     against += " (the odd rays; the even ones make the pilot that centres the reference)";
-    if (is_source) against += " (the rays it was built from: errors shared with them cancel)";
   } else {
+    // The bundle's own rays (--independent) get no pilot: every pilot from them shares rays with the levels.
     report = lumx::evaluate_apl_errors(set, *rays, o);
     if (is_source) against += " (the rays it was built from: errors shared with them cancel)";
   }

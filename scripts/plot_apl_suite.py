@@ -59,7 +59,7 @@ def main(argv):
     for ax, (emitter, series) in zip(axes, panels.items()):
         for name, (d, e) in series.items():
             ax.plot(d, e, label=name, **STYLE.get(name, {}))
-        ax.axhline(2.0, color="tab:green", linewidth=0.8)  # issue target for the Lambertian emitters and spots
+        ax.axhline(2.0, color="tab:green", linewidth=0.8)  # the 2 % target for the Lambertian emitters and spots
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_ylim(0.5, 1000.0)

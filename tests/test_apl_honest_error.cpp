@@ -28,7 +28,7 @@ namespace {
 #if defined(__SANITIZE_ADDRESS__)
 constexpr std::uint64_t kSuiteRays = 200000;  // the sanitizer build checks agreement on fewer rays
 #else
-constexpr std::uint64_t kSuiteRays = 1000000;  // the targets are stated for 1 M rays
+constexpr std::uint64_t kSuiteRays = 1000000;  // the targets (docs/apl_sets.md) are stated for 1 M rays
 #endif
 
 PlanarEmitter lambertian_disk() { return {"Lambertian disk r = 0.1 m", PlanarEmitter::Shape::disk, 0.1, 0, 1, 1000}; }
@@ -206,7 +206,7 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
       if (e.resolved) {
         EXPECT_NEAR(e.relative_rmse_noise_removed, t, slack) << where;
       } else {
-        // An upper bound (two standard errors) holds the truth but for the issue's ±25 % agreement.
+        // An upper bound (two standard errors) holds the truth but for the ±25 % agreement.
         EXPECT_LE(0.75 * t, e.noise_removed_upper) << where;
       }
     }
@@ -214,13 +214,13 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
   }
   std::printf("  noise floor        :");
   for (const auto& s : r.reference.sphere) std::printf("  %5.2f      ", 100 * s.noise_floor);
-  std::printf("\n  reference (shift / pilot's excess, %% of the mean):");
+  std::printf("\n  reference (shift / the pilot's shape error, upper bound, %% of the mean):");
   for (const auto& s : r.reference.sphere)
     std::printf(" %s %.1f/%.1f", s.centred ? "centre" : "mean", 100 * s.centring_shift, 100 * s.pilot_shape_error);
   std::printf("\n");
 #if !defined(__SANITIZE_ADDRESS__)
   // What the shape check decides, where it matters: the spots' lobes, a few patches wide, are centred
-  // from d = 1 on (their patch means there are 13–75 % from the centre values); the box's beams, whose
+  // from d = 1 on (their 512-APL levels, 3–6 % off at points, are 13–75 % off the exact patch means there); the box's beams, whose
   // sharp borders the pilot blurs as the levels do, keep their patch means at every d.
   for (const SphereReference& s : r.reference.sphere) {
     if (GetParam() == 2 || GetParam() == 3) {
@@ -238,7 +238,7 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
 INSTANTIATE_TEST_SUITE_P(Emitters, HonestErrorSuite, ::testing::Range(0, 7));
 
 // What lumx build ships (every ray, resolutions fitted on held-out rays) against the exact irradiance at
-// the patch centres, per level and distance: the figures the targets are stated for.
+// the patch centres, per level and distance: the figures the targets are stated for.
 class ShippedSetSuite : public ::testing::TestWithParam<int> {};
 
 TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
@@ -358,7 +358,7 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
       EXPECT_LE(levels[k][s], far[s] + 0.01) << set.levels[k].size() << " APLs, d = " << ms.relative_distances()[s];
   // The finest level at d ≥ 1, as the fitted maps reach it (docs/apl_sets.md): the disk 0.90-1.00 % and
   // the rectangle 1.02-1.08 % (local linear kernels; 1.80-1.87 % when the fit graded against patch means
-  // rather than centred references, FitReference above; the target is 2 %), the cos^20 spot
+  // rather than centred references, FitReference above; the target is 2 %), the cos^20 spot
   // 1.87-3.17 % (R 128, σ 3.4° sharpened; 1.93-4.32 % when the kernels stopped at R 64), the cos^50 spot
   // 2.90-4.40 % (R 128, σ 1.7° sharpened; 3.0-11.3 % with R 64 chosen against patch means:
   // SpotStudy.DISABLED_MoreRaysHelpOnlyNearTheSpots).
@@ -371,7 +371,7 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
     if (d >= 1) {
       EXPECT_LT(levels.back()[s], guard[GetParam()]) << d;
     }
-    // The targets for the Lambertian emitters: ≤ 5 % at d = 0.5 (1.05 and 1.84 % measured); the
+    // The targets for the Lambertian emitters: ≤ 5 % at d = 0.5 (1.05 and 1.84 % measured); the
     // far field, as the one-APL level (1.85/1.91 and 1.97/1.88 %) and as the attached IES (1.03/0.98 and
     // 1.42/1.10 %; sharpened 2.05/2.02 and 2.33/2.13 %), ≤ 2 % at d ≥ 5.
     if (GetParam() <= 1 && d == 0.5) {

@@ -36,7 +36,7 @@ struct Apl {
 };
 
 /// Relative RMSE of a level's irradiance against a reference, on spheres of relative distance d
-/// (000 §5.3, eq. 5.1). Filled by the builder (issue 4); read by the error-target level choice.
+/// (000 §5.3, eq. 5.1). Filled by the builder; read by the error-target level choice.
 struct ErrorTable {
   std::vector<double> relative_distance;  ///< d = |x − c| / D, increasing
   std::vector<double> relative_rmse;      ///< one per distance

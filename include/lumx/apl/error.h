@@ -21,7 +21,8 @@
 //         crosses the sphere ahead of it, and is otherwise counted in `missed`.
 //   - Held-out rays. The reference must come from rays the set was not built from: evaluate_held_out
 //     builds from the even rays and gathers the reference from the odd ones (rays/holdout.h; each half's
-//     flux ×2, so both estimate the whole luminaire). Against its own rays a set's noise is the
+//     flux ×2, so both estimate the whole luminaire), or, when the reference is centred (below), from
+//     rays 3, 7, 11, … while rays 1, 5, 9, … make the pilot. Against its own rays a set's noise is the
 //     reference's noise and cancels: on the 100 k-ray OSRAM blue LED that scored every level below the
 //     rays' noise floor. evaluate_apl_errors grades a given set against given rays and is honest only when
 //     they are independent of it.
@@ -349,7 +350,7 @@ struct SphereReference {
   double noise_floor = NAN;         ///< σ = √(mean v_i) / mean E_ref: the ε an exact model would show
   double split_noise_floor = NAN;   ///< noise_floor(half_even, half_odd): the same from the halves' scatter
   double centring_shift = NAN;      ///< checked_centred_reference: RMS move to the patch centres / mean E_ref
-  double pilot_shape_error = NAN;   ///< checked_centred_reference: the pilot's excess shape error / mean E_ref
+  double pilot_shape_error = NAN;   ///< checked_centred_reference: upper bound of the pilot's shape error / mean E_ref
   double pilot_shape_noise = NAN;   ///< checked_centred_reference: the rays' noise in that test / mean E_ref
   /// False: E_ref per patch is the patch mean Σ Φ / A. True: moved to the patch centres by a pilot's shape
   /// within each patch (centred_reference), where a level evaluated at one point per patch is queried.
@@ -588,6 +589,11 @@ struct AplErrorReport {
 };
 
 inline AplSet centring_pilot(const AplSet& set, double sigma = 0);
+/// Whether the held-out evaluators centre the reference (checked_centred_reference) for these options:
+/// one point per patch (the levels queried at the patch centres) and quarters within the spheres' limit.
+inline bool centring_applies(const AplErrorOptions& o) {
+  return o.patch_subsamples == 1 && 2 * o.patch_resolution <= 1024;
+}
 inline double centring_pilot_sigma(int patch_resolution);
 inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& ref, const ReferenceIrradiance& fine,
                                                      const AplSet& pilot, const AplErrorOptions& options);
@@ -599,17 +605,18 @@ inline ReferenceIrradiance centred_reference(const ReferenceIrradiance& ref, con
 /// centring_pilot_sigma(options.patch_resolution)) and one point per patch
 /// (AplErrorOptions::patch_subsamples == 1), the reference is moved from the patch means to the patch
 /// centres (centred_reference), where the levels are queried: graded against patch means, a model right
-/// at points is charged with the patch's own curvature (a cos^50 spot's 512-APL level, 12.8 % off at
-/// points at d = 10, was reported at 73 %). Averaged queries (k ≠ 1) keep the patch means they are
+/// at points is charged with the patch's own curvature (a cos^50 spot's 512-APL level, 6.3 % off at
+/// points at d = 10, is 74.5 % off the exact patch means). Averaged queries (k ≠ 1) keep the patch means they are
 /// compared with. Throws std::invalid_argument for a set without levels, bad options or a bad ray.
 inline AplErrorReport evaluate_apl_errors(const AplSet& set, RaySource& rays, const AplErrorOptions& options = {},
                                           const AplSet* pilot = nullptr) {
   if (set.levels.empty()) throw std::invalid_argument("apl_error: the set has no level");
   AplErrorReport report;
   report.reference = gather_reference(rays, set.bounds, options);
-  if (pilot && options.patch_subsamples == 1 && 2 * options.patch_resolution <= 1024) {
+  if (pilot && centring_applies(options)) {
     AplErrorOptions fine = options;
     fine.patch_resolution = 2 * options.patch_resolution;
+    fine.progress = nullptr;
     report.reference = checked_centred_reference(report.reference, gather_reference(rays, set.bounds, fine), *pilot, options);
   }
   const std::size_t rows = set.levels.size() + (options.far_field ? 1 : 0);
@@ -631,6 +638,7 @@ inline AplErrorReport evaluate_apl_errors(const AplSet& set, RaySource& rays, co
 /// reference is centred where a pilot's shape passes the check (evaluate_apl_errors); the odd rays are then
 /// split again, as in evaluate_held_out_fitted: a set `build` makes from rays 1, 5, 9, … gives the pilot and
 /// rays 3, 7, 11, … grade, so the pilot is independent of both the graded set and the rays that check it.
+/// Where no pilot can be built from those rays (too few, or no flux) every odd ray grades, uncentred.
 template <class Build>
 AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorOptions& options = {}) {
   AplSet set;
@@ -639,11 +647,13 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
     set = build(static_cast<RaySource&>(train));
   }
   RayHalf odd(rays, 1);
-  if (options.patch_subsamples != 1) return evaluate_apl_errors(set, odd, options);
+  if (!centring_applies(options)) return evaluate_apl_errors(set, odd, options);
   AplSet pilot;
-  {
+  try {
     RayHalf pilot_rays(odd, 0);
     pilot = centring_pilot(build(static_cast<RaySource&>(pilot_rays)), centring_pilot_sigma(options.patch_resolution));
+  } catch (const std::invalid_argument&) {
+    return evaluate_apl_errors(set, odd, options);
   }
   RayHalf test(odd, 1);
   return evaluate_apl_errors(set, test, options, &pilot);
@@ -653,15 +663,18 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
 /// the reference is centred where a pilot's shape passes the check (evaluate_apl_errors): `build_pilot`
 /// (RaySource& → AplSet; e.g. one level of 64 APLs, built as the set was) makes the pilot from the even
 /// rays and the levels are graded on the odd ones, so the pilot shares no ray with the rays that check
-/// and grade. Otherwise every ray grades.
+/// and grade. Otherwise (no centring for these options, or no pilot from the even rays: too few, or no
+/// flux) every ray grades, uncentred.
 template <class Build>
 AplErrorReport evaluate_independent(const AplSet& set, RaySource& rays, Build&& build_pilot,
                                     const AplErrorOptions& options = {}) {
-  if (options.patch_subsamples != 1) return evaluate_apl_errors(set, rays, options);
+  if (!centring_applies(options)) return evaluate_apl_errors(set, rays, options);
   AplSet pilot;
-  {
+  try {
     RayHalf even(rays, 0);
     pilot = centring_pilot(build_pilot(static_cast<RaySource&>(even)), centring_pilot_sigma(options.patch_resolution));
+  } catch (const std::invalid_argument&) {
+    return evaluate_apl_errors(set, rays, options);
   }
   RayHalf odd(rays, 1);
   return evaluate_apl_errors(set, odd, options, &pilot);
@@ -987,7 +1000,9 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
 /// lobe's shape within a patch is kept, the texel noise mostly averaged) of width `sigma` (rad), or with
 /// sigma = 0 of 1.5 texel widths of the level's maps where the kernels reach (the fit's pilot: R 128 maps,
 /// 3/8 of an R 32 fit patch). For sigma > 0 the maps are first halved (flux-exact) while they are finer
-/// than the kernels take (R > 128, or a kernel of more than SphereMapKernel::kMaxWeights weights). Throws
+/// than the kernels take (R > 128, or a kernel of more than a quarter of SphereMapKernel::kMaxWeights
+/// weights). Maps coarser than R 32, or that cannot be halved to 128 (odd R), are left unsmoothed: such a
+/// pilot is noisy, and the shape check (checked_centred_reference) mostly refuses it. Throws
 /// std::invalid_argument for a set without levels.
 inline AplSet centring_pilot(const AplSet& set, double sigma) {
   if (set.levels.empty()) throw std::invalid_argument("centring_pilot: the set has no level");
@@ -1008,7 +1023,8 @@ inline AplSet centring_pilot(const AplSet& set, double sigma) {
     const double cut = std::log(1e3) * sigma * sigma;  // 1 − cos of the kernel's truncation (κ = 1/σ²)
     auto too_fine = [&](int r) {
       const double T = 2.0 * double(r) * double(r);
-      return r > SphereMapKernel::kMaxResolution || T * T * std::min(1.0, cut / 2.0) > double(SphereMapKernel::kMaxWeights);
+      return r > SphereMapKernel::kMaxResolution ||
+             T * T * std::min(1.0, cut / 2.0) > double(SphereMapKernel::kMaxWeights / 4);
     };
     int to = R;
     while (too_fine(to) && to % 2 == 0 && to / 2 >= 32) to /= 2;
@@ -1026,9 +1042,9 @@ inline AplSet centring_pilot(const AplSet& set, double sigma) {
 
 /// The width (rad) of the pilot that centres a grading reference on patches of resolution R_patch
 /// (centring_pilot): 3/8 of a patch's width √(4π/N). Narrower, the pilot's own noise swamps the
-/// reference's: with σ = 1.5 texels of R 128 maps (a fifth of an R 16 patch) and 250 000 rays behind each,
-/// a Lambertian disk's 512-APL level, 1.6–1.9 % off at points, was estimated at 5–8 %; at 3/8 of the patch,
-/// 3.2 % at d = 0.5 and below the floor elsewhere, while a cos^50 spot's estimates follow its point errors
+/// reference's: with σ = 1.5 texels of R 128 maps (3/16 of an R 16 patch) and 250 000 rays behind each,
+/// every sphere centred (a trial), a Lambertian disk's 512-APL level, 1.6–1.9 % off at points, was
+/// estimated at 5–8 %. At 3/8 the spots' centred estimates follow their point errors
 /// (tests/test_apl_honest_error.cpp, HonestErrorSuite). The fit's pilot (sigma 0) has the same ratio to
 /// the fit's R 32 patches.
 inline double centring_pilot_sigma(int patch_resolution) {
@@ -1088,18 +1104,18 @@ inline ReferenceIrradiance centred_reference(const ReferenceIrradiance& ref, con
 /// about their patch's mean by the rays' noise alone: E Σ_j (r_ij − r̄_i)² = ¾ Σ_j v_ij. A pilot that
 /// blurs what the rays resolve (a sharp shadow border: the pilot, made of APLs like the graded level,
 /// shares its blur) leaves more, and centring by it would move the reference towards that blur and
-/// flatter every level like it. A sphere is centred only where the pilot's excess (noise removed) is under
-/// a third of the move it would make; else it keeps its patch means (SphereReference::centred false), and
-/// its errors are against them. (The excess is over quarters; at a single point the pilot can be off by
-/// about twice as much, so a third keeps what centring adds under about two thirds of what it removes. At
-/// a half, a 200 k-ray rectangle's sphere at d = 0.5 (0.44) was centred by a wrong shape: 14.6 % estimated
-/// against 2.2 % at points.) Per sphere, `centring_shift` is the RMS of the move and `pilot_shape_error` that
-/// of the pilot's excess over the quarters, both relative to the mean irradiance. Measured
-/// (tests/test_apl_honest_error.cpp, HonestErrorSuite, 1 M rays, R 16 patches): the spots' spheres at d ≥ 1
-/// pass (excess 0–0.28 of the move, which is 12–69 % of the mean: a cos^50 spot's 512-APL level,
-/// 6.3 % off at points at d = 10, is estimated at 8.6 % where its patch means made it 73 %); the point
-/// sources in a box with holes fail at every d (0.95–1.2: centred, its 512-APL level, 41–48 % off at
-/// points, was estimated at 21–27 %; against patch means 36–38 %).
+/// flatter every level like it. A sphere is centred only where the pilot's excess (noise removed), taken at
+/// its upper bound (two standard errors above the estimate, from the scatter of the per-patch terms), is
+/// under half the move it would make; else it keeps its patch means (SphereReference::centred false), and
+/// its errors are against them. (Without the bound, a 200 k-ray rectangle's sphere at d = 0.5, its point
+/// estimate 0.44 of the move, was centred by a wrong shape: 14.6 % estimated against 2.2 % at points.)
+/// Per sphere, `centring_shift` is the RMS of the move and `pilot_shape_error` that bound over the
+/// quarters, both relative to the mean irradiance. Measured (tests/test_apl_honest_error.cpp,
+/// HonestErrorSuite, 1 M rays, R 16 patches): the spots' spheres from d = 0.75 pass (bound 0.17–0.47 of
+/// the move, which is 8–69 % of the mean: a cos^50 spot's 512-APL level, 6.3 % off at points at d = 10,
+/// is estimated at 8.6 % where it is 74.5 % off the exact patch means); the point sources in a box with
+/// holes fail at every d (1.1–1.45: centred, its 512-APL level, 41–48 % off at points, would be estimated
+/// at 21–27 %; against patch means it is estimated at 32–38 %).
 inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& ref, const ReferenceIrradiance& fine,
                                                      const AplSet& pilot, const AplErrorOptions& options) {
   const int R = ref.spheres.patch_resolution();
@@ -1132,31 +1148,38 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
     const SphereReference& fr = fine.sphere[s];
     const std::vector<double>& pq = quarters.irradiance[s];
     std::vector<double> delta(sr.irradiance.size());
-    double q = 0, q0 = 0, shift = 0, mean = 0;
+    double q = 0, q0 = 0, shift = 0, mean = 0, excess_sq = 0;
     for (std::size_t y = 0; y < std::size_t(R); ++y)
       for (std::size_t x = 0; x < W; ++x) {
         const std::size_t p = y * W + x;
         std::size_t f[4];
         for (int b = 0; b < 2; ++b)
           for (int a = 0; a < 2; ++a) f[2 * b + a] = (2 * y + std::size_t(b)) * Wf + 2 * x + std::size_t(a);
-        double pbar = 0, rbar = 0, r[4];
+        double pbar = 0, rbar = 0, r[4], qi = 0, q0i = 0;
         for (int j = 0; j < 4; ++j) {
           pbar += 0.25 * pq[f[j]];
           r[j] = fr.irradiance[f[j]] - pq[f[j]];
           rbar += 0.25 * r[j];
-          q0 += 0.75 * fr.variance[f[j]];
+          q0i += 0.75 * fr.variance[f[j]];
         }
-        for (int j = 0; j < 4; ++j) q += (r[j] - rbar) * (r[j] - rbar);
+        for (int j = 0; j < 4; ++j) qi += (r[j] - rbar) * (r[j] - rbar);
+        q += qi;
+        q0 += q0i;
+        excess_sq += (qi - q0i) * (qi - q0i);
         delta[p] = centre.irradiance[s][p] - pbar;
         shift += delta[p] * delta[p];
         mean += sr.irradiance[p];
       }
     const double n = double(sr.irradiance.size());
     mean /= n;
+    // The excess q − q0 is a sum of n per-patch terms; its standard error from their scatter about their
+    // mean, and the check uses the upper bound q − q0 + 2·SE, so a pilot is not trusted on noise alone.
+    const double mean_excess = (q - q0) / n;
+    const double se = std::sqrt(std::max(0.0, excess_sq / n - mean_excess * mean_excess) * n);
     sr.centring_shift = mean > 0 ? std::sqrt(shift / n) / mean : 0.0;
-    sr.pilot_shape_error = mean > 0 ? std::sqrt(std::max(0.0, q - q0) / (4 * n)) / mean : 0.0;
+    sr.pilot_shape_error = mean > 0 ? std::sqrt(std::max(0.0, q - q0 + 2 * se) / (4 * n)) / mean : 0.0;
     sr.pilot_shape_noise = mean > 0 ? std::sqrt(q0 / (4 * n)) / mean : 0.0;
-    sr.centred = 3 * sr.pilot_shape_error < sr.centring_shift;
+    sr.centred = 2 * sr.pilot_shape_error < sr.centring_shift;
     if (!sr.centred) continue;
     for (std::size_t p = 0; p < sr.irradiance.size(); ++p)
       sr.irradiance[p] = std::max(0.0, sr.irradiance[p] + delta[p]);
@@ -1202,7 +1225,7 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
     {
       const AplSet from_fit = build(static_cast<RaySource&>(fit));
       pilot = centring_pilot(from_fit);
-      if (options.patch_subsamples == 1)
+      if (centring_applies(options))
         grading_pilot = centring_pilot(from_fit, centring_pilot_sigma(options.patch_resolution));
     }
     const ReferenceIrradiance fit_ref = centred_reference(gather_reference(fit, set.bounds, quiet), pilot, quiet);
@@ -1217,7 +1240,8 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
     c.far_field_mode = far_choice.mode.at(0);
   }
   // The grading reference is centred by a pilot from the same rays, 1, 5, 9, …: neither the graded set's
-  // nor the grading rays', so its shape is independent of both; wider, for the grading's coarser patches.
+  // maps' nor the grading rays' (they only chose the graded set's resolutions and kernels, a discrete
+  // choice), so its shape's noise is independent of both; wider, for the grading's coarser patches.
   RayHalf test(odd, 1);
   AplErrorReport report =
       evaluate_apl_errors(set, test, options, grading_pilot.levels.empty() ? nullptr : &grading_pilot);
