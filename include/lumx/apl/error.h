@@ -631,34 +631,6 @@ inline AplErrorReport evaluate_apl_errors(const AplSet& set, RaySource& rays, co
   return report;
 }
 
-/// Honest errors of the sets a builder makes from a rayset: `build(RaySource&) -> AplSet` is called on the
-/// even rays of `rays` (flux ×2, rays/holdout.h) and its set graded against the odd rays (flux ×2), which
-/// it never saw. The set built from all the rays has
-/// half this set's noise variance, so these errors bound its own from above. With one point per patch the
-/// reference is centred where a pilot's shape passes the check (evaluate_apl_errors); the odd rays are then
-/// split again, as in evaluate_held_out_fitted: a set `build` makes from rays 1, 5, 9, … gives the pilot and
-/// rays 3, 7, 11, … grade, so the pilot is independent of both the graded set and the rays that check it.
-/// Where no pilot can be built from those rays (too few, or no flux) every odd ray grades, uncentred.
-template <class Build>
-AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorOptions& options = {}) {
-  AplSet set;
-  {
-    RayHalf train(rays, 0);
-    set = build(static_cast<RaySource&>(train));
-  }
-  RayHalf odd(rays, 1);
-  if (!centring_applies(options)) return evaluate_apl_errors(set, odd, options);
-  AplSet pilot;
-  try {
-    RayHalf pilot_rays(odd, 0);
-    pilot = centring_pilot(build(static_cast<RaySource&>(pilot_rays)), centring_pilot_sigma(options.patch_resolution));
-  } catch (const std::invalid_argument&) {
-    return evaluate_apl_errors(set, odd, options);
-  }
-  RayHalf test(odd, 1);
-  return evaluate_apl_errors(set, test, options, &pilot);
-}
-
 /// Grades `set` against `rays` it was not built from (another run, another file). With one point per patch
 /// the reference is centred where a pilot's shape passes the check (evaluate_apl_errors): `build_pilot`
 /// (RaySource& → AplSet; e.g. one level of 64 APLs, built as the set was) makes the pilot from the even
@@ -678,6 +650,27 @@ AplErrorReport evaluate_independent(const AplSet& set, RaySource& rays, Build&& 
   }
   RayHalf odd(rays, 1);
   return evaluate_apl_errors(set, odd, options, &pilot);
+}
+
+/// Honest errors of the sets a builder makes from a rayset: `build(RaySource&) -> AplSet` is called on the
+/// even rays of `rays` (flux ×2, rays/holdout.h) and its set graded against the odd rays (flux ×2), which
+/// it never saw. The set built from all the rays has
+/// half this set's noise variance, so these errors bound its own from above. With one point per patch the
+/// reference is centred where a pilot's shape passes the check (evaluate_apl_errors); the odd rays are then
+/// split again, as in evaluate_held_out_fitted: a set `build` makes from rays 1, 5, 9, … gives the pilot and
+/// rays 3, 7, 11, … grade, so the pilot is independent of both the graded set and the rays that check it.
+/// Where no pilot can be built from those rays (too few, or no flux) every odd ray grades, uncentred.
+template <class Build>
+AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorOptions& options = {}) {
+  AplSet set;
+  {
+    RayHalf train(rays, 0);
+    set = build(static_cast<RaySource&>(train));
+  }
+  // The odd rays are to this set what another run's rays are: the pilot from rays 1, 5, 9, …, the
+  // grading on rays 3, 7, 11, ….
+  RayHalf odd(rays, 1);
+  return evaluate_independent(set, odd, build, options);
 }
 
 // ---- Map resolution by held-out error
@@ -1107,15 +1100,15 @@ inline ReferenceIrradiance centred_reference(const ReferenceIrradiance& ref, con
 /// flatter every level like it. A sphere is centred only where the pilot's excess (noise removed), taken at
 /// its upper bound (two standard errors above the estimate, from the scatter of the per-patch terms), is
 /// under half the move it would make; else it keeps its patch means (SphereReference::centred false), and
-/// its errors are against them. (Without the bound, a 200 k-ray rectangle's sphere at d = 0.5, its point
+/// its errors are against them. (Without the bound, in a trial, a 200 k-ray rectangle's sphere at d = 0.5, its point
 /// estimate 0.44 of the move, was centred by a wrong shape: 14.6 % estimated against 2.2 % at points.)
 /// Per sphere, `centring_shift` is the RMS of the move and `pilot_shape_error` that bound over the
 /// quarters, both relative to the mean irradiance. Measured (tests/test_apl_honest_error.cpp,
 /// HonestErrorSuite, 1 M rays, R 16 patches): the spots' spheres from d = 0.75 pass (bound 0.17–0.47 of
 /// the move, which is 8–69 % of the mean: a cos^50 spot's 512-APL level, 6.3 % off at points at d = 10,
 /// is estimated at 8.6 % where it is 74.5 % off the exact patch means); the point sources in a box with
-/// holes fail at every d (1.1–1.45: centred, its 512-APL level, 41–48 % off at points, would be estimated
-/// at 21–27 %; against patch means it is estimated at 32–38 %).
+/// holes fail at every d (1.1–1.45: centred anyway, in a trial, its 512-APL level, 41–48 % off at points,
+/// was estimated at 21–27 %; against patch means it is estimated at 32–38 %).
 inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& ref, const ReferenceIrradiance& fine,
                                                      const AplSet& pilot, const AplErrorOptions& options) {
   const int R = ref.spheres.patch_resolution();
