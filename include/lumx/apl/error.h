@@ -351,7 +351,6 @@ struct SphereReference {
   double split_noise_floor = NAN;   ///< noise_floor(half_even, half_odd): the same from the halves' scatter
   double centring_shift = NAN;      ///< checked_centred_reference: RMS move to the patch centres / mean E_ref
   double pilot_shape_error = NAN;   ///< checked_centred_reference: upper bound of the pilot's shape error / mean E_ref
-  double pilot_shape_noise = NAN;   ///< checked_centred_reference: the rays' noise in that test / mean E_ref
   /// False: E_ref per patch is the patch mean Σ Φ / A. True: moved to the patch centres by a pilot's shape
   /// within each patch (centred_reference), where a level evaluated at one point per patch is queried.
   bool centred = false;
@@ -1044,6 +1043,25 @@ inline double centring_pilot_sigma(int patch_resolution) {
   return 0.375 * std::sqrt(4.0 * kPi / (2.0 * double(patch_resolution) * double(patch_resolution)));
 }
 
+/// Level 0 of `pilot` on the spheres and patches of `like`, averaged over k × k points per patch (k = 1:
+/// the patch centres), per sphere: the shapes centred_reference and checked_centred_reference move by.
+inline std::vector<std::vector<double>> pilot_on_patches(const AplSet& pilot, const ReferenceIrradiance& like,
+                                                        const AplErrorOptions& options, int k) {
+  AplErrorOptions o = options;
+  o.min_timing_seconds = 0;
+  o.progress = nullptr;
+  o.relative_distances = like.spheres.relative_distances();
+  o.patch_resolution = like.spheres.patch_resolution();
+  o.rotated_patches = like.spheres.rotated_patches();
+  o.patch_subsamples = k;
+  BoundingSphere bounds;
+  bounds.center = like.spheres.centre();
+  bounds.radius = 0.5 * like.spheres.diameter();
+  ReferenceIrradiance at = like;
+  at.spheres = MeasurementSpheres(bounds, o);
+  return evaluate_level(pilot, 0, at, o).irradiance;
+}
+
 /// The reference moved from patch means to patch centres, where fit_map_resolutions evaluates its
 /// candidates: E_c = max(0, E + P(centre) − P̄), with P a pilot model (level 0 of `pilot`, e.g.
 /// centring_pilot of a set built from other rays) and P̄ its mean over the patch (k × k sub-points).
@@ -1066,26 +1084,11 @@ inline ReferenceIrradiance centred_reference(const ReferenceIrradiance& ref, con
                                              const AplErrorOptions& options, int k) {
   if (k < 2 || k > 16) throw std::invalid_argument("centred_reference: k must be in [2, 16]");
   ReferenceIrradiance out = ref;
-  AplErrorOptions o = options;
-  o.min_timing_seconds = 0;
-  o.progress = nullptr;
-  o.relative_distances = ref.spheres.relative_distances();
-  o.patch_resolution = ref.spheres.patch_resolution();
-  o.rotated_patches = ref.spheres.rotated_patches();
-  BoundingSphere bounds;
-  bounds.center = ref.spheres.centre();
-  bounds.radius = 0.5 * ref.spheres.diameter();
-  ReferenceIrradiance with_k = ref;  // the same patches, evaluated at 1 and at k × k points each
-  o.patch_subsamples = 1;
-  with_k.spheres = MeasurementSpheres(bounds, o);
-  const LevelErrors at_centre = evaluate_level(pilot, 0, with_k, o);
-  o.patch_subsamples = k;
-  with_k.spheres = MeasurementSpheres(bounds, o);
-  const LevelErrors mean = evaluate_level(pilot, 0, with_k, o);
+  const std::vector<std::vector<double>> at_centre = pilot_on_patches(pilot, ref, options, 1),
+                                         mean = pilot_on_patches(pilot, ref, options, k);
   for (std::size_t s = 0; s < out.sphere.size(); ++s) {
     std::vector<double>& e = out.sphere[s].irradiance;
-    for (std::size_t p = 0; p < e.size(); ++p)
-      e[p] = std::max(0.0, e[p] + at_centre.irradiance[s][p] - mean.irradiance[s][p]);
+    for (std::size_t p = 0; p < e.size(); ++p) e[p] = std::max(0.0, e[p] + at_centre[s][p] - mean[s][p]);
     out.sphere[s].centred = true;
   }
   return out;
@@ -1115,31 +1118,15 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
   if (fine.spheres.patch_resolution() != 2 * R || fine.sphere.size() != ref.sphere.size() ||
       fine.spheres.rotated_patches() != ref.spheres.rotated_patches())
     throw std::invalid_argument("checked_centred_reference: the fine reference is not on the quarters of the patches");
-  AplErrorOptions o = options;
-  o.min_timing_seconds = 0;
-  o.progress = nullptr;
-  o.relative_distances = ref.spheres.relative_distances();
-  o.rotated_patches = ref.spheres.rotated_patches();
-  BoundingSphere bounds;
-  bounds.center = ref.spheres.centre();
-  bounds.radius = 0.5 * ref.spheres.diameter();
-  ReferenceIrradiance at = ref;
-  o.patch_resolution = R;
-  o.patch_subsamples = 1;
-  at.spheres = MeasurementSpheres(bounds, o);
-  const LevelErrors centre = evaluate_level(pilot, 0, at, o);
+  const std::vector<std::vector<double>> centre = pilot_on_patches(pilot, ref, options, 1);
   // The quarters' means at 2 × 2 points each: the same 4 × 4 points per patch as centred_reference's P̄.
-  ReferenceIrradiance at_fine = fine;
-  o.patch_resolution = 2 * R;
-  o.patch_subsamples = 2;
-  at_fine.spheres = MeasurementSpheres(bounds, o);
-  const LevelErrors quarters = evaluate_level(pilot, 0, at_fine, o);
+  const std::vector<std::vector<double>> quarters = pilot_on_patches(pilot, fine, options, 2);
   ReferenceIrradiance out = ref;
   const std::size_t W = std::size_t(2 * R), Wf = 2 * W;
   for (std::size_t s = 0; s < out.sphere.size(); ++s) {
     SphereReference& sr = out.sphere[s];
     const SphereReference& fr = fine.sphere[s];
-    const std::vector<double>& pq = quarters.irradiance[s];
+    const std::vector<double>& pq = quarters[s];
     std::vector<double> delta(sr.irradiance.size());
     double q = 0, q0 = 0, shift = 0, mean = 0, excess_sq = 0;
     for (std::size_t y = 0; y < std::size_t(R); ++y)
@@ -1159,7 +1146,7 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
         q += qi;
         q0 += q0i;
         excess_sq += (qi - q0i) * (qi - q0i);
-        delta[p] = centre.irradiance[s][p] - pbar;
+        delta[p] = centre[s][p] - pbar;
         shift += delta[p] * delta[p];
         mean += sr.irradiance[p];
       }
@@ -1171,7 +1158,6 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
     const double se = std::sqrt(std::max(0.0, excess_sq / n - mean_excess * mean_excess) * n);
     sr.centring_shift = mean > 0 ? std::sqrt(shift / n) / mean : 0.0;
     sr.pilot_shape_error = mean > 0 ? std::sqrt(std::max(0.0, q - q0 + 2 * se) / (4 * n)) / mean : 0.0;
-    sr.pilot_shape_noise = mean > 0 ? std::sqrt(q0 / (4 * n)) / mean : 0.0;
     sr.centred = 2 * sr.pilot_shape_error < sr.centring_shift;
     if (!sr.centred) continue;
     for (std::size_t p = 0; p < sr.irradiance.size(); ++p)
