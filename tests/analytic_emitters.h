@@ -147,6 +147,35 @@ class PlanarEmitter : public AnalyticEmitter {
   std::vector<Node> nodes_;
 };
 
+/// Another emitter turned by `degrees` about the y axis (rays and exact irradiance alike): the same light
+/// aimed elsewhere, to tell what depends on where a lobe falls on the maps from what does not.
+class RotatedEmitter : public AnalyticEmitter {
+ public:
+  RotatedEmitter(std::unique_ptr<AnalyticEmitter> inner, double degrees)
+      : inner_(std::move(inner)), degrees_(degrees), c_(std::cos(degrees * lumx::kPi / 180)),
+        s_(std::sin(degrees * lumx::kPi / 180)) {}
+  std::string name() const override {
+    return inner_->name() + ", turned " + std::to_string(int(std::lround(degrees_))) + "° about y";
+  }
+  lumx::RayChunk rays(std::uint64_t n, std::uint64_t seed) const override {
+    const lumx::RayChunk in = inner_->rays(n, seed);
+    lumx::RayChunk out;
+    out.reserve(in.size());
+    for (std::size_t i = 0; i < in.size(); ++i)
+      out.push_back(glm::vec3(turn(glm::dvec3(in.position(i)))), glm::vec3(turn(glm::dvec3(in.direction(i)))), in.flux[i]);
+    return out;
+  }
+  double irradiance(const glm::dvec3& x, const glm::dvec3& normal) const override {
+    return inner_->irradiance(unturn(x), unturn(normal));
+  }
+
+ private:
+  glm::dvec3 turn(const glm::dvec3& v) const { return {c_ * v.x + s_ * v.z, v.y, -s_ * v.x + c_ * v.z}; }
+  glm::dvec3 unturn(const glm::dvec3& v) const { return {c_ * v.x - s_ * v.z, v.y, s_ * v.x + c_ * v.z}; }
+  std::unique_ptr<AnalyticEmitter> inner_;
+  double degrees_, c_, s_;
+};
+
 class PinholeBox : public AnalyticEmitter {
  public:
   struct Hole {
