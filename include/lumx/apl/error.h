@@ -792,7 +792,10 @@ struct FitKernel {
 /// (SphereMapKernel::sharpening_gain: bias O(κ⁻²), so a spot's lobe keeps its peak) at σ = 0.75, 1.5 and 3
 /// texel widths; and local linear (SphereMapKernel::local_linear_gain: no leak across the border of the
 /// rays' support, such as a Lambertian emitter's horizon, where the others put most of their error) at
-/// σ = 1.5 and 3 texel widths. R 128's kernels are for narrow lobes: a spot read through R 64 texels keeps
+/// σ = 1.5 and 3 texel widths; extrapolated (SphereMapKernel::extrapolated_gain: bias O(κ⁻³), for a lobe
+/// a wide kernel would flatten even sharpened) and two-scale (SphereMapKernel::two_scale_gain: each map at
+/// σ against its own few rays, the level's shape from its sum sharpened at σ/2; fit_map_resolutions tries
+/// it at the level's built resolution only) at σ = 1.5 and 3 texel widths. R 128's kernels are for narrow lobes: a spot read through R 64 texels keeps
 /// their blur (a cos^20 spot's far field 4 % off, noise-free), and R 128 with a kernel as wide as R 64's
 /// averages the same noise through finer texels (apl_sets.md).
 inline std::vector<FitKernel> fit_kernels(int R) {
@@ -882,42 +885,6 @@ inline double cost_difference_standard_error(const ReferenceIrradiance& ref, con
   return std::sqrt(sq / double(n - 1) / double(n));
 }
 
-/// Whether candidate values `a` are worse than `b` beyond their noise on some sphere: log ε_a − log ε_b,
-/// per sphere, more than two of its standard errors (the per-patch terms of cost_difference_standard_error,
-/// on that sphere alone). fit_map_resolutions keeps a level of several APLs from being worse than its
-/// one-APL level (the far-field point) anywhere: what the geometric mean over distances allows when a
-/// candidate halves the near field's error and loses the far field (a cos^20 spot's 512-APL level, R 64
-/// with a two-scale kernel: 0.9–1.0 % at d ≤ 1 and 4.4 % at d = 10, against 3.0 % for the far field).
-inline bool worse_somewhere(const ReferenceIrradiance& ref, const std::vector<std::vector<double>>& a,
-                            const std::vector<std::vector<double>>& b) {
-  for (std::size_t s = 0; s < ref.sphere.size() && s < a.size() && s < b.size(); ++s) {
-    const std::vector<double>& e = ref.sphere[s].irradiance;
-    const std::size_t n = e.size();
-    if (n < 2 || a[s].size() != n || b[s].size() != n) continue;
-    double mean_ref = 0, sa = 0, sb = 0;
-    for (std::size_t p = 0; p < n; ++p) {
-      mean_ref += e[p];
-      sa += (a[s][p] - e[p]) * (a[s][p] - e[p]);
-      sb += (b[s][p] - e[p]) * (b[s][p] - e[p]);
-    }
-    mean_ref /= double(n);
-    const double m2 = mean_ref * mean_ref, ea2 = sa / double(n) / m2, eb2 = sb / double(n) / m2;
-    if (!(ea2 > 0) || !(eb2 > 0) || !std::isfinite(ea2 + eb2) || ea2 <= eb2) continue;
-    const double scale = 2 * m2 * 0.5 * (ea2 + eb2);
-    double mean = 0, sq = 0;
-    std::vector<double> d(n);
-    for (std::size_t p = 0; p < n; ++p) {
-      const double ra = (a[s][p] - e[p]) * (a[s][p] - e[p]), rb = (b[s][p] - e[p]) * (b[s][p] - e[p]);
-      d[p] = (ra - rb) / scale;
-      mean += d[p] / double(n);
-    }
-    for (double v : d) sq += (v - mean) * (v - mean);
-    const double se = std::sqrt(sq / double(n - 1) / double(n));
-    if (0.5 * std::log(ea2 / eb2) > 2 * se) return true;
-  }
-  return false;
-}
-
 /// The map bytes (in memory) above which fit_map_resolutions trades a level's finer maps for coarser ones
 /// the held-out rays cannot tell apart from them (the one-standard-error rule): 1 MiB, an eighth of the
 /// 8 MiB a 512-APL bundle from 1 M rays is given.
@@ -935,7 +902,6 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
   AplErrorOptions o = options;
   o.min_timing_seconds = 0;
   const auto kernel_for = [](int R, double kappa) { return SphereMapKernel::shared(R, kappa); };
-  std::vector<std::vector<double>> far_values;  // the fitted one-APL level's model values, when level 0 is one
   for (std::size_t k = 0; k < set.levels.size(); ++k) {
     const AplLevel built = set.levels[k];
     std::vector<FitCandidate> tried;
@@ -945,14 +911,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     std::vector<std::pair<FitCandidate, std::vector<std::vector<double>>>> eligible;
     std::vector<std::vector<double>> last_values;  // the model values of the candidate graded last
     std::size_t best_at = 0;
-    // Candidates worse than the one-APL level somewhere (worse_somewhere), kept only in case every
-    // candidate is.
-    std::vector<std::pair<FitCandidate, std::vector<std::vector<double>>>> refused;
     const auto admit = [&]() {
-      if (k > 0 && !far_values.empty() && worse_somewhere(ref, last_values, far_values)) {
-        refused.emplace_back(tried.back(), std::move(last_values));
-        return;
-      }
       eligible.emplace_back(tried.back(), std::move(last_values));
       if (tried.back().cost < best.cost) best = tried.back(), best_at = eligible.size() - 1;
     };
@@ -977,6 +936,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       admit();
       for (const FitKernel& kernel : set_rays > 0 ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
+        // Two-scale keeps the level's sum sharp at a distance, so only where the maps are fine enough to
+        // hold it: at a coarser R it traded the far field for the near field, and the fitting rays could not
+        // see the loss (a cos^20 spot's 512-APL level at R 64: 0.9–1.0 % at d ≤ 1, 4.4 % at d = 10 against
+        // 3.0 % for the far-field point; graded 12.6 against 12.2 % over an 11.8 % noise floor).
         if (kernel.mode == KernelMode::two_scale && R != built.map_resolution) continue;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where a
         // patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7° lowered the
@@ -1012,11 +975,6 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     // keeps the best: that the held-out rays cannot tell two candidates apart is no evidence that the
     // coarser is as good (in a trial applying the rule to every level, a cos^20 spot's 8-APL level went to
     // R 64 and was 4.3 % off at d = 10 against 3.1 %; the suite's far-field test refused it).
-    if (eligible.empty() && !refused.empty()) {
-      eligible = std::move(refused);
-      for (std::size_t i = 0; i < eligible.size(); ++i)
-        if (eligible[i].first.cost < best.cost) best = eligible[i].first, best_at = i;
-    }
     const double scale = double(best.resolution) / double(std::max(1, built.map_resolution));
     if (!eligible.empty() && double(built.map_bytes()) * scale * scale > kParsimonyBytes) {
       const std::vector<std::vector<double>>& best_values = eligible[best_at].second;
@@ -1035,7 +993,6 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     choice.kappa.push_back(best.kappa);
     choice.mode.push_back(best.kappa > 0 ? best.mode : KernelMode::plain);
     choice.tried.push_back(std::move(tried));
-    if (k == 0 && set.levels[0].size() == 1) far_values = evaluate_level(set, 0, ref, o).irradiance;
   }
   return choice;
 }
