@@ -359,9 +359,9 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // The finest level at d ≥ 1, as the fitted maps reach it (docs/apl_sets.md): the disk 0.90-1.00 % and
   // the rectangle 1.02-1.08 % (local linear kernels; 1.80-1.87 % when the fit graded against patch means
   // rather than centred references, FitReference above; the target is 2 %), the cos^20 spot
-  // 1.87-3.17 % (R 128, σ 3.4° sharpened; 1.93-4.32 % when the kernels stopped at R 64), the cos^50 spot
-  // 2.90-4.40 % (R 128, σ 1.7° sharpened; 3.0-11.3 % with R 64 chosen against patch means:
-  // SpotStudy.DISABLED_WhatMoreRaysBuy).
+  // 1.87-2.90 % (R 128, σ 3.4° extrapolated; 1.87-3.17 % sharpened, 1.93-4.32 % when the kernels stopped
+  // at R 64), the cos^50 spot 1.48-4.58 % (R 128, σ 3.4° two-scale; 2.90-4.40 % sharpened at σ 1.7°,
+  // 3.0-11.3 % with R 64 chosen against patch means: SpotStudy.DISABLED_WhatMoreRaysBuy).
   // The box with holes: 37.0-41.3 % (49.3-53.1 % when the half set's maps were one step coarser than the
   // shipped set's, so the fit could not choose the resolution the shipped set is built at); exact maps at
   // R 64 are 33-36 % off there (PinholeBoxStudy.DISABLED_ExactBeamsAtTheSourcesBoundWhatMapsCanDo).

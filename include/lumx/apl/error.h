@@ -741,7 +741,7 @@ inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& ker
   const std::size_t n = out.apls.size();
   if (threads == 0) threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   threads = unsigned(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 8)));
-  // Sharpened or local linear: one gain from the level's sum (its far field) for every map
+  // Any mode but plain: one gain from the level's sum (its far field) for every map
   // (SphereMapKernel::apply_with_gain), so the sparse maps sum to the sum's estimate.
   const bool with_gain = mode != KernelMode::plain;
   SphereMap gain;
@@ -940,7 +940,8 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         // hold it: at a coarser R it traded the far field for the near field, and the fitting rays could not
         // see the loss (a cos^20 spot's 512-APL level at R 64: 0.9–1.0 % at d ≤ 1, 4.4 % at d = 10 against
         // 3.0 % for the far-field point; graded 12.6 against 12.2 % over an 11.8 % noise floor).
-        if (kernel.mode == KernelMode::two_scale && R != built.map_resolution) continue;
+        // On one map it is the sharpened kernel at σ/2, already a candidate.
+        if (kernel.mode == KernelMode::two_scale && (R != built.map_resolution || built.size() <= 1)) continue;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where a
         // patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7° lowered the
         // peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10). Kept with the

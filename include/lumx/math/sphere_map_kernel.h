@@ -45,11 +45,11 @@ LUMX_NAMESPACE_BEGIN
 /// (SphereMapKernel::sharpening_gain); or as the weights of a local linear fit inside the rays' support
 /// (SphereMapKernel::local_linear_gain).
 /// extrapolated: the blur extrapolated to zero from K·f, K²·f and K³·f (SphereMapKernel::extrapolated_gain:
-/// bias O(κ⁻³) where sharpening leaves O(κ⁻²)). two_scale: each map smoothed by K, the level's shape from
+/// its leading two orders of blur cancelled where sharpening cancels one). two_scale: each map smoothed by K, the level's shape from
 /// its sum sharpened at half K's width (SphereMapKernel::two_scale_gain).
 enum class KernelMode { plain, sharpened, local_linear, extrapolated, two_scale };
 
-/// "", "sharpened", "local linear" or "extrapolated" (for reports and the bundle's provenance).
+/// "", "sharpened", "local linear", "extrapolated" or "two-scale" (for reports and the bundle's provenance).
 inline const char* kernel_mode_name(KernelMode mode) {
   switch (mode) {
     case KernelMode::sharpened: return "sharpened";
@@ -245,8 +245,10 @@ class SphereMapKernel {
   /// On the sphere at this scale K^j is a heat kernel of variance j/κ per axis, and reading a map adds
   /// b = h²/4 (sharpening_strength), so K^j·f as read is f + (j + β)·(Δf/2κ) + (j + β)²·(Δ²f/8κ²) + …,
   /// β = κb. Richardson extrapolation to zero blur through the three nodes t_j = j + β: the estimate
-  /// Σ c_j K^j·f with c_j = Π_{i≠j} t_i / (t_i − t_j) (Lagrange's basis at 0) cancels the first two orders,
-  /// leaving O(κ⁻³) (for β = 0, 3K − 3K² + K³, iterated twicing: Stuetzle & Mittal 1979). Sharpening is
+  /// Σ c_j K^j·f with c_j = Π_{i≠j} t_i / (t_i − t_j) (Lagrange's basis at 0) cancels the first two orders
+  /// (for β = 0, 3K − 3K² + K³, iterated twicing: Stuetzle & Mittal 1979). K (von Mises–Fisher, truncated)
+  /// and a lookup's blur (a texel mean read bilinearly) are Gaussian to leading order only, so what is left
+  /// is of their higher moments as well as O(κ⁻³). Sharpening is
   /// the same construction through two nodes (c = 1 + α, −α). The weights are larger (|c| up to 3 + …),
   /// so its noise is about 1.15× the sharpened estimate's at the same κ (Gaussian kernels: Σ c_i c_j /
   /// (i + j) = 1.22 against 0.92): a wider kernel buys the noise back, which the held-out fit decides.
@@ -269,6 +271,9 @@ class SphereMapKernel {
     std::vector<double> estimate(T);
     for (std::size_t i = 0; i < T; ++i) {
       flux += double(k1.data()[i]);
+      // Where K·f is 0 the gain is 0 (beyond K's reach c₂K² + c₃K³ can be positive): keep it out of the
+      // flux the rescaling matches.
+      if (!(k1.data()[i] > 0)) continue;
       estimate[i] = std::max(0.0, c[0] * double(k1.data()[i]) + c[1] * double(k2.data()[i]) + c[2] * double(k3.data()[i]));
       kept += estimate[i];
     }
