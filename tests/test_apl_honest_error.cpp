@@ -75,6 +75,19 @@ std::vector<double> true_errors(const std::vector<std::vector<double>>& exact, c
   return out;
 }
 
+/// The set lumx build ships from `rays` (two threads): fitted on held-out rays, then built from every ray
+/// with the fit applied; `choice` receives the fit.
+AplSet shipped_set(RaySource& rays, ResolutionChoice& choice) {
+  AplBuildOptions bo;
+  bo.threads = 2;
+  const AplBuildOptions half_bo = half_rays_build_options(bo, rays.info().ray_count);
+  const AplErrorReport held_out =
+      evaluate_held_out_fitted(rays, [&](RaySource& r) { return build_apl_set(r, half_bo); }, AplErrorOptions{}, &choice);
+  AplSet set = build_apl_set(rays, bo);
+  if (!apply_held_out_fit(set, held_out, &choice)) throw std::runtime_error("shipped_set: the fit does not apply");
+  return set;
+}
+
 /// Level k's irradiance at the evaluation points `dirs` of sphere s, each queried alone as a renderer does.
 std::vector<double> level_at_points(const AplSet& set, std::size_t k, const MeasurementSpheres& ms, std::size_t s,
                                     const std::vector<glm::dvec3>& dirs) {
@@ -756,11 +769,7 @@ TEST(SpotStudy, DISABLED_WhatMoreRaysBuy) {
       bo.threads = 2;
       AplErrorOptions eo;
       ResolutionChoice choice;
-      const AplBuildOptions half_bo = half_rays_build_options(bo, rays->info().ray_count);
-      const auto build_half = [&](RaySource& r) { return build_apl_set(r, half_bo); };
-      const AplErrorReport held_out = evaluate_held_out_fitted(*rays, build_half, eo, &choice);
-      AplSet set = build_apl_set(*rays, bo);
-      ASSERT_TRUE(apply_held_out_fit(set, held_out, &choice));
+      const AplSet set = shipped_set(*rays, choice);
       const MeasurementSpheres ms(set.bounds, eo);
       const ExactOnSpheres exact = exact_on_spheres(*em, ms, 1);
       const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);
@@ -869,17 +878,10 @@ TEST(SpotStudy, DISABLED_SpotBiasAndNoise) {
       std::unique_ptr<MeasurementSpheres> spheres;
       for (int k = 0; k < K; ++k) {
         auto rays = em->source(1000000, 101 + std::uint64_t(k));
-        AplBuildOptions bo;
-        bo.threads = 2;
-        AplErrorOptions eo;
         ResolutionChoice choice;
-        const AplBuildOptions half_bo = half_rays_build_options(bo, rays->info().ray_count);
-        const auto build_half = [&](RaySource& r) { return build_apl_set(r, half_bo); };
-        const AplErrorReport held_out = evaluate_held_out_fitted(*rays, build_half, eo, &choice);
-        AplSet set = build_apl_set(*rays, bo);
-        ASSERT_TRUE(apply_held_out_fit(set, held_out, &choice));
+        const AplSet set = shipped_set(*rays, choice);
         // The first seed's spheres for every seed: the same points, so the errors can be averaged.
-        if (k == 0) spheres = std::make_unique<MeasurementSpheres>(set.bounds, eo);
+        if (k == 0) spheres = std::make_unique<MeasurementSpheres>(set.bounds, AplErrorOptions{});
         const MeasurementSpheres& ms = *spheres;
         const ExactOnSpheres exact = exact_on_spheres(*em, ms, 1);
         const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);

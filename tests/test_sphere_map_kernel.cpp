@@ -34,6 +34,23 @@ SphereMap map_of(int R, F&& f) {
   return m;
 }
 
+/// A map of resolution R whose texels hold f's mean over 4 × 4 sub-directions (what a texel of a noise-free
+/// histogram holds, up to the sub-sampling).
+template <class F>
+SphereMap texel_mean_map(int R, F&& f) {
+  SphereMap m(R, 1);
+  for (int y = 0; y < R; ++y)
+    for (int x = 0; x < 2 * R; ++x) {
+      double sum = 0;
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i)
+          sum += f(glm::normalize(glm::dvec3(sphere_map::uv_to_direction(
+              {(float(x) + (float(i) + 0.5f) / 4) / float(2 * R), (float(y) + (float(j) + 0.5f) / 4) / float(R)}))));
+      m.at(x, y, 0) = float(sum / 16);
+    }
+  return m;
+}
+
 }  // namespace
 
 TEST(SphereMapKernel, KeepsFluxAndSpreadsOneTexelAsTheKernel) {
@@ -385,16 +402,7 @@ TEST(SphereMapKernel, NoiseFreeSpotsShowWhatTexelMapsCanDo) {
       const auto lobe = [&](const glm::dvec3& w) { return std::pow(std::max(0.0, glm::dot(w, a)), m); };
       for (int ri = 0; ri < 2; ++ri) {
         const int R = ri == 0 ? 64 : 128;
-        SphereMap exact(R, 1);
-        for (int y = 0; y < R; ++y)
-          for (int x = 0; x < 2 * R; ++x) {
-            double sum = 0;
-            for (int j = 0; j < 4; ++j)
-              for (int i = 0; i < 4; ++i)
-                sum += lobe(glm::normalize(glm::dvec3(sphere_map::uv_to_direction(
-                    {(float(x) + (float(i) + 0.5f) / 4) / float(2 * R), (float(y) + (float(j) + 0.5f) / 4) / float(R)}))));
-            exact.at(x, y, 0) = float(sum / 16);
-          }
+        const SphereMap exact = texel_mean_map(R, lobe);
         const double texel = std::sqrt(4.0 * kPi / (2.0 * R * R));
         double best = INFINITY;
         for (const double widths : {0.0, 0.75, 1.5}) {
@@ -430,16 +438,7 @@ TEST(SphereMapKernel, ExtrapolatingThroughThreeKernelsRemovesWhatSharpeningLeave
   const SphereMapKernel k(R, 1.0 / ((3 * texel) * (3 * texel)));
   const glm::dvec3 axis = glm::normalize(glm::dvec3(1, 0, 1));
   const auto f = [&](const glm::dvec3& w) { return std::pow(std::max(0.0, glm::dot(w, axis)), 20.0); };
-  SphereMap m(R, 1);
-  for (int y = 0; y < R; ++y)
-    for (int x = 0; x < 2 * R; ++x) {
-      double s = 0;
-      for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i)
-          s += f(glm::normalize(glm::dvec3(sphere_map::uv_to_direction(
-              {(float(x) + (float(i) + 0.5f) / 4) / float(2 * R), (float(y) + (float(j) + 0.5f) / 4) / float(R)}))));
-      m.at(x, y, 0) = float(s / 16);
-    }
+  const SphereMap m = texel_mean_map(R, f);
   const SphereMap sharp = k.apply(m, KernelMode::sharpened), extra = k.apply(m, KernelMode::extrapolated);
   EXPECT_NEAR(map_sum(extra), map_sum(m), 1e-5 * map_sum(m));
   for (float v : extra.values()) EXPECT_GE(v, 0.0f);
