@@ -265,6 +265,30 @@ TEST(SphereMapKernel, SharpeningKeepsANarrowLobesPeakWherePlainSmoothingLowersIt
     }
 }
 
+/// 512 APLs sharing `rays` rays of one cos^20 lobe about +z (ray i to APL i mod 512), one unit of flux a
+/// ray, binned at R; `total` is their sum. A level's maps as sparse as the finest level's are.
+struct SparseLobeLevel {
+  AplLevel level;
+  SphereMap total;
+};
+SparseLobeLevel sparse_cos20_level(int R, int rays, std::uint64_t seed) {
+  SparseLobeLevel out{AplLevel{}, SphereMap(R, 1)};
+  out.level.map_resolution = R;
+  out.level.apls.resize(512);
+  for (Apl& a : out.level.apls) a.map = SphereMap(R, 1);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < rays; ++i) {
+    // cos θ = u^(1/21) draws θ from the pdf ∝ cos^20 θ per solid angle.
+    const double ct = std::pow(u(rng), 1.0 / 21.0), st = std::sqrt(1 - ct * ct), phi = 2 * kPi * u(rng);
+    const glm::vec2 uv = sphere_map::direction_to_uv(glm::vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct)));
+    const int x = std::min(2 * R - 1, int(uv.x * 2 * R)), y = std::min(R - 1, int(uv.y * R));
+    out.level.apls[std::size_t(i) % 512].map.at(x, y, 0) += 1.0f;
+    out.total.at(x, y, 0) += 1.0f;
+  }
+  return out;
+}
+
 TEST(SphereMapKernel, SharpenedLevelSumsToTheSharpenedSumWhereSharpeningEachMapFlattensIt) {
   // A level's maps are sparse: 512 APLs share 50 000 rays of one cos^20 lobe at R 32 (~2 rays a lit texel). With one gain from the
   // level's sum (smoothed_level), the maps sum to the sum's sharpened estimate, up to each map's flux
@@ -273,20 +297,9 @@ TEST(SphereMapKernel, SharpenedLevelSumsToTheSharpenedSumWhereSharpeningEachMapF
   const int R = 32;
   const double texel = std::sqrt(4.0 * kPi / (2.0 * R * R));
   const SphereMapKernel k(R, 1.0 / ((1.5 * texel) * (1.5 * texel)));
-  AplLevel level;
-  level.map_resolution = R;
-  level.apls.resize(512);
-  for (Apl& a : level.apls) a.map = SphereMap(R, 1);
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  SphereMap total(R, 1);
-  for (int i = 0; i < 50000; ++i) {
-    const double ct = std::pow(u(rng), 1.0 / 21.0), st = std::sqrt(1 - ct * ct), phi = 2 * kPi * u(rng);
-    const glm::vec2 uv = sphere_map::direction_to_uv(glm::vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct)));
-    const int x = std::min(2 * R - 1, int(uv.x * 2 * R)), y = std::min(R - 1, int(uv.y * R));
-    level.apls[std::size_t(i) % 512].map.at(x, y, 0) += 1.0f;
-    total.at(x, y, 0) += 1.0f;
-  }
+  const SparseLobeLevel sparse = sparse_cos20_level(R, 50000, 7);
+  const AplLevel& level = sparse.level;
+  const SphereMap& total = sparse.total;
   const AplLevel shared = smoothed_level(level, k, 2, KernelMode::sharpened);
   const SphereMap expected = k.apply_sharpened(total);
   SphereMap sum_shared(R, 1), sum_alone(R, 1);
@@ -473,21 +486,10 @@ TEST(SphereMapKernel, TwoScaleMapsSumToTheNarrowSharpenedSumAndAreSmootherEachTh
   const SphereMapKernel wide(R, kappa_wide);
   EXPECT_EQ(4.0 * kappa_wide, kappa_narrow);  // the fit's kernels: the narrow one is cached already
   const auto narrow = SphereMapKernel::shared(R, kappa_narrow);
-  AplLevel level;
-  level.map_resolution = R;
-  level.apls.resize(512);
-  for (Apl& a : level.apls) a.map = SphereMap(R, 1);
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  SphereMap total(R, 1);
   const int rays = 200000;
-  for (int i = 0; i < rays; ++i) {
-    const double ct = std::pow(u(rng), 1.0 / 21.0), st = std::sqrt(1 - ct * ct), phi = 2 * kPi * u(rng);
-    const glm::vec2 uv = sphere_map::direction_to_uv(glm::vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct)));
-    const int x = std::min(2 * R - 1, int(uv.x * 2 * R)), y = std::min(R - 1, int(uv.y * R));
-    level.apls[std::size_t(i) % 512].map.at(x, y, 0) += 1.0f;
-    total.at(x, y, 0) += 1.0f;
-  }
+  const SparseLobeLevel sparse = sparse_cos20_level(R, rays, 11);
+  const AplLevel& level = sparse.level;
+  const SphereMap& total = sparse.total;
   const AplLevel two = smoothed_level(level, wide, 2, KernelMode::two_scale);
   const AplLevel sharp = smoothed_level(level, *narrow, 2, KernelMode::sharpened);
   const SphereMap expected = narrow->apply_sharpened(total);

@@ -732,24 +732,24 @@ inline AplLevel downsampled_level(const AplLevel& level, int R) {
   return out;
 }
 
-/// The level's maps smoothed by `kernel` (whose resolution must be theirs) in `mode`, on up to `threads`
-/// threads (0: the hardware's); each map is smoothed alone, so the result does not depend on the thread
-/// count.
-inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& kernel, unsigned threads = 0,
-                               KernelMode mode = KernelMode::plain) {
+/// A level's maps summed over its APLs and channels (one channel at its resolution): its far field.
+inline SphereMap level_sum(const AplLevel& level) {
+  SphereMap total(level.map_resolution, 1);
+  for (const Apl& a : level.apls) accumulate_channels(total, a.map);
+  return total;
+}
+
+/// The level's maps smoothed by `kernel` (whose resolution must be theirs) in `mode` with `gain` already
+/// taken from the level's sum (kernel.gain(level_sum(level), mode); not read in plain mode), on up to
+/// `threads` threads (0: the hardware's). Each map is smoothed alone, so the result does not depend on the
+/// thread count.
+inline AplLevel smoothed_level_with_gain(const AplLevel& level, const SphereMapKernel& kernel, KernelMode mode,
+                                         const SphereMap& gain, unsigned threads = 0) {
   AplLevel out = level;
   const std::size_t n = out.apls.size();
   if (threads == 0) threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   threads = unsigned(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 8)));
-  // Any mode but plain: one gain from the level's sum (its far field) for every map
-  // (SphereMapKernel::apply_with_gain), so the sparse maps sum to the sum's estimate.
   const bool with_gain = mode != KernelMode::plain;
-  SphereMap gain;
-  if (with_gain && n > 0) {
-    SphereMap total(kernel.resolution(), 1);
-    for (const Apl& a : level.apls) accumulate_channels(total, a.map);
-    gain = kernel.gain(total, mode);
-  }
   const auto run = [&](std::size_t from, std::size_t to) {
     for (std::size_t i = from; i < to; ++i)
       out.apls[i].map = with_gain ? kernel.apply_with_gain(level.apls[i].map, gain) : kernel.apply(level.apls[i].map);
@@ -762,6 +762,16 @@ inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& ker
     for (std::thread& t : pool) t.join();
   }
   return out;
+}
+
+/// The level's maps smoothed by `kernel` in `mode`. Any mode but plain takes one gain from the level's sum
+/// (its far field) for every map (SphereMapKernel::apply_with_gain), so the sparse maps sum to the sum's
+/// estimate.
+inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& kernel, unsigned threads = 0,
+                               KernelMode mode = KernelMode::plain) {
+  const SphereMap gain =
+      mode != KernelMode::plain && !level.apls.empty() ? kernel.gain(level_sum(level), mode) : SphereMap();
+  return smoothed_level_with_gain(level, kernel, mode, gain, threads);
 }
 
 /// The fitted maps of a level: downsampled to R, then smoothed by the kernel of κ in `mode` when κ > 0.
@@ -816,14 +826,11 @@ inline std::vector<FitKernel> fit_kernels(int R) {
 /// the smoothed sum, brightest first, that hold 5 % of its flux (chosen on the smoothed map, so that texels
 /// bright by noise alone are not picked and then "lowered" back to their mean); the lowering is of the
 /// plain sum's mean over them, and the allowance 2/√n, n = set_rays · (their share of the plain flux)
-/// (the rays that fell there, for rays of equal flux). Returns {lowering, allowance}.
-inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const SphereMapKernel& kernel,
-                                                    std::uint64_t set_rays, KernelMode mode = KernelMode::plain) {
-  const int R = level.map_resolution;
-  if (level.apls.empty() || set_rays == 0) return {1.0, 0.0};
-  SphereMap sum(R, 1);
-  for (const Apl& a : level.apls) accumulate_channels(sum, a.map);
-  const SphereMap smooth = kernel.apply(sum, mode);
+/// (the rays that fell there, for rays of equal flux). Returns {lowering, allowance}. Here from the level's
+/// plain sum and that sum smoothed.
+inline std::pair<double, double> kernel_peak_change(const SphereMap& sum, const SphereMap& smooth,
+                                                    std::uint64_t set_rays) {
+  if (set_rays == 0) return {1.0, 0.0};
   std::vector<std::uint32_t> order(sum.texel_count());
   for (std::size_t t = 0; t < order.size(); ++t) order[t] = std::uint32_t(t);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -841,6 +848,14 @@ inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const
   if (!(plain > 0)) return {0.0, 0.0};
   const double rays_there = double(set_rays) * plain / total;
   return {(plain - smoothed) / plain, 2.0 / std::sqrt(std::max(1.0, rays_there))};
+}
+
+/// kernel_peak_change of a level smoothed by `kernel` in `mode`.
+inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const SphereMapKernel& kernel,
+                                                    std::uint64_t set_rays, KernelMode mode = KernelMode::plain) {
+  if (level.apls.empty() || set_rays == 0) return {1.0, 0.0};
+  const SphereMap sum = level_sum(level);
+  return kernel_peak_change(sum, kernel.apply(sum, mode), set_rays);
 }
 
 /// The standard error of the difference of two candidates' Σ_d log ε(d) (fit_map_resolutions), from their
@@ -931,6 +946,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     std::vector<double> plain_errors, kernel_errors;
     for (int R = built.map_resolution; R >= std::max(1, min_resolution); R /= 2) {
       const AplLevel at_r = downsampled_level(built, R);
+      const SphereMap sum_at_r = level_sum(at_r);
       set.levels[k] = at_r;
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       admit();
@@ -938,17 +954,24 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         const double kappa = kernel.kappa;
         // Two-scale keeps the level's sum sharp at a distance, so only where the maps are fine enough to
         // hold it: at a coarser R it traded the far field for the near field, and the fitting rays could not
-        // see the loss (a cos^20 spot's 512-APL level at R 64: 0.9–1.0 % at d ≤ 1, 4.4 % at d = 10 against
-        // 3.0 % for the far-field point; graded 12.6 against 12.2 % over an 11.8 % noise floor).
+        // see the loss (in a trial allowing it at every R, a cos^20 spot's 512-APL level at R 64 was
+        // 0.9–1.0 % at d ≤ 1 and 4.4 % at d = 10 against 3.0 % for the far-field point, yet graded within the
+        // fit's standard error of the R 128 candidates: apl_sets.md).
         // On one map it is the sharpened kernel at σ/2, already a candidate.
         if (kernel.mode == KernelMode::two_scale && (R != built.map_resolution || built.size() <= 1)) continue;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where a
         // patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7° lowered the
         // peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10). Kept with the
         // centred reference, which is only as sharp as its pilot.
-        const auto [lowering, allowance] = kernel_peak_change(at_r, *kernel_for(R, kappa), set_rays, kernel.mode);
+        // The gain is the level sum's, taken once for the guard and the smoothing.
+        const std::shared_ptr<const SphereMapKernel> held = kernel_for(R, kappa);
+        const SphereMapKernel& kern = *held;
+        const bool plain_mode = kernel.mode == KernelMode::plain;
+        const SphereMap gain = plain_mode ? SphereMap() : kern.gain(sum_at_r, kernel.mode);
+        const auto [lowering, allowance] = kernel_peak_change(
+            sum_at_r, plain_mode ? kern.apply(sum_at_r) : kern.apply_with_gain(sum_at_r, gain), set_rays);
         if (lowering > allowance) continue;
-        set.levels[k] = smoothed_level(at_r, *kernel_for(R, kappa), 0, kernel.mode);
+        set.levels[k] = smoothed_level_with_gain(at_r, kern, kernel.mode, gain);
         grade(R, kappa, kernel.mode, kernel_errors);
         // A kernel must not give away any distance against the same maps unsmoothed: its bias is largest at
         // a narrow peak, which patches coarser than the peak see only in part, at some distances
