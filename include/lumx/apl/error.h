@@ -802,10 +802,13 @@ struct FitKernel {
 /// (SphereMapKernel::sharpening_gain: bias O(κ⁻²), so a spot's lobe keeps its peak) at σ = 0.75, 1.5 and 3
 /// texel widths; and local linear (SphereMapKernel::local_linear_gain: no leak across the border of the
 /// rays' support, such as a Lambertian emitter's horizon, where the others put most of their error) at
-/// σ = 1.5 and 3 texel widths; extrapolated (SphereMapKernel::extrapolated_gain: bias O(κ⁻³), for a lobe
-/// a wide kernel would flatten even sharpened) and two-scale (SphereMapKernel::two_scale_gain: each map at
-/// σ against its own few rays, the level's shape from its sum sharpened at σ/2; fit_map_resolutions tries
-/// it at the level's built resolution only) at σ = 1.5 and 3 texel widths. R 128's kernels are for narrow lobes: a spot read through R 64 texels keeps
+/// σ = 1.5 and 3 texel widths; extrapolated (SphereMapKernel::extrapolated_gain: two orders of blur
+/// cancelled where sharpening cancels one, for a lobe a wide kernel would flatten even sharpened) at σ = 1.5
+/// and 3 texel widths; and two-scale (SphereMapKernel::two_scale_gain: each map at σ against its own few
+/// rays, the level's shape from its sum sharpened at σ/2; fit_map_resolutions tries it at the level's
+/// built resolution only) at σ = 1.5, 3 and 4.5 texel widths (4.5: a cos^20 spot's maps from 1 M rays,
+/// about 2 000 rays each, want σ 5° while its sum wants 2.5°; over four seeds that brought the finest level
+/// from 1.87–3.21 % to 1.61–3.18 %, apl_sets.md). R 128's kernels are for narrow lobes: a spot read through R 64 texels keeps
 /// their blur (a cos^20 spot's far field 4 % off, noise-free), and R 128 with a kernel as wide as R 64's
 /// averages the same noise through finer texels (apl_sets.md).
 inline std::vector<FitKernel> fit_kernels(int R) {
@@ -817,7 +820,7 @@ inline std::vector<FitKernel> fit_kernels(int R) {
   for (double widths : {0.75, 1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::sharpened});
   for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::local_linear});
   for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::extrapolated});
-  for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::two_scale});
+  for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::two_scale});
   return out;
 }
 
