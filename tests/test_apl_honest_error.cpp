@@ -233,7 +233,7 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
   std::printf("\n");
 #if !defined(__SANITIZE_ADDRESS__)
   // What the shape check decides, where it matters: the spots' lobes, a few patches wide, are centred
-  // from d = 1 on (their 512-APL levels, 3–6 % off at points, are 13–75 % off the exact patch means there); the box's beams, whose
+  // from d = 1 on (their 512-APL levels, 2–7 % off at points, are 13–75 % off the exact patch means there); the box's beams, whose
   // sharp borders the pilot blurs as the levels do, keep their patch means at every d.
   for (const SphereReference& s : r.reference.sphere) {
     if (GetParam() == 2 || GetParam() == 3) {
@@ -373,8 +373,9 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // the rectangle 1.02-1.08 % (local linear kernels; 1.80-1.87 % when the fit graded against patch means
   // rather than centred references, FitReference above; the target is 2 %), the cos^20 spot
   // 1.19-3.28 % (R 128, σ 5.0° two-scale; 1.87-2.90 % extrapolated at σ 3.4°, 1.87-3.17 % sharpened,
-  // 1.93-4.32 % when the kernels stopped at R 64), the cos^50 spot 1.48-4.58 % (R 128, σ 3.4° two-scale; 2.90-4.40 % sharpened at σ 1.7°,
-  // 3.0-11.3 % with R 64 chosen against patch means: SpotStudy.DISABLED_WhatMoreRaysBuy).
+  // 1.93-4.32 % when the kernels stopped at R 64), the cos^50 spot 1.48-4.58 % (R 128, σ 3.4° two-scale;
+  // 2.90-4.40 % sharpened at σ 1.7°, 3.0-11.3 % with R 64 chosen against patch means:
+  // SpotStudy.DISABLED_WhatMoreRaysBuy).
   // The box with holes: 37.0-41.3 % (49.3-53.1 % when the half set's maps were one step coarser than the
   // shipped set's, so the fit could not choose the resolution the shipped set is built at); exact maps at
   // R 64 are 33-36 % off there (PinholeBoxStudy.DISABLED_ExactBeamsAtTheSourcesBoundWhatMapsCanDo).

@@ -265,6 +265,7 @@ TEST(SphereMapKernel, SharpeningKeepsANarrowLobesPeakWherePlainSmoothingLowersIt
     }
 }
 
+namespace {
 /// 512 APLs sharing `rays` rays of one cos^20 lobe about +z (ray i to APL i mod 512), one unit of flux a
 /// ray, binned at R; `total` is their sum. A level's maps as sparse as the finest level's are.
 struct SparseLobeLevel {
@@ -288,6 +289,7 @@ SparseLobeLevel sparse_cos20_level(int R, int rays, std::uint64_t seed) {
   }
   return out;
 }
+}  // namespace
 
 TEST(SphereMapKernel, SharpenedLevelSumsToTheSharpenedSumWhereSharpeningEachMapFlattensIt) {
   // A level's maps are sparse: 512 APLs share 50 000 rays of one cos^20 lobe at R 32 (~2 rays a lit texel). With one gain from the

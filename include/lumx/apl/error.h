@@ -807,10 +807,11 @@ struct FitKernel {
 /// and 3 texel widths; and two-scale (SphereMapKernel::two_scale_gain: each map at σ against its own few
 /// rays, the level's shape from its sum sharpened at σ/2; fit_map_resolutions tries it at the level's
 /// built resolution only) at σ = 1.5, 3 and 4.5 texel widths (4.5: a cos^20 spot's maps from 1 M rays,
-/// about 2 000 rays each, want σ 5° while its sum wants 2.5°; over four seeds that brought the finest level
-/// from 1.87–3.21 % to 1.61–3.18 %, apl_sets.md). R 128's kernels are for narrow lobes: a spot read through R 64 texels keeps
-/// their blur (a cos^20 spot's far field 4 % off, noise-free), and R 128 with a kernel as wide as R 64's
-/// averages the same noise through finer texels (apl_sets.md).
+/// about 2 000 rays each, want σ 5° while its sum affords 2.5°; over four seeds its finest level is
+/// 1.62–3.18 % at d ≥ 1 with that candidate and 1.87–3.21 % without, apl_sets.md). R 128's kernels are for
+/// narrow lobes: a spot read through R 64 texels keeps their blur (a cos^20 spot's far field 4 % off,
+/// noise-free), and R 128 with a kernel as wide as R 64's averages the same noise through finer texels
+/// (apl_sets.md).
 inline std::vector<FitKernel> fit_kernels(int R) {
   std::vector<FitKernel> out;
   for (double kappa : fit_kernel_kappas(R)) out.push_back({kappa, KernelMode::plain});
@@ -953,7 +954,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       set.levels[k] = at_r;
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       admit();
-      for (const FitKernel& kernel : set_rays > 0 ? fit_kernels(R) : std::vector<FitKernel>{}) {
+      for (const FitKernel& kernel : set_rays > 0 && !at_r.apls.empty() ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
         // Two-scale keeps the level's sum sharp at a distance, so only where the maps are fine enough to
         // hold it: at a coarser R it traded the far field for the near field, and the fitting rays could not
