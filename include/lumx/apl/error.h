@@ -806,9 +806,10 @@ struct FitKernel {
 /// cancelled where sharpening cancels one, for a lobe a wide kernel would flatten even sharpened) at σ = 1.5
 /// and 3 texel widths; and two-scale (SphereMapKernel::two_scale_gain: each map at σ against its own few
 /// rays, the level's shape from its sum sharpened at σ/2; fit_map_resolutions tries it at the level's
-/// built resolution only) at σ = 1.5, 3 and 4.5 texel widths (4.5: a cos^20 spot's maps from 1 M rays,
-/// about 2 000 rays each, want σ 5° while its sum affords 2.5°; over four seeds its finest level is
-/// 1.62–3.18 % at d ≥ 1 with that candidate and 1.87–3.21 % without, apl_sets.md). R 128's kernels are for
+/// built resolution only, and widens it only while that helps) at σ = 1.5, 3 and 4.5 texel widths (4.5: a
+/// cos^20 spot's maps from 1 M rays, about 2 000 rays each, want σ 5° while its sum affords 2.5°; over
+/// four seeds its finest level is 1.62–3.18 % at d ≥ 1 with that candidate and 1.87–3.21 % without,
+/// apl_sets.md). R 128's kernels are for
 /// narrow lobes: a spot read through R 64 texels keeps their blur (a cos^20 spot's far field 4 % off,
 /// noise-free), and R 128 with a kernel as wide as R 64's averages the same noise through finer texels
 /// (apl_sets.md).
@@ -926,12 +927,15 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     std::vector<FitCandidate> tried;
     FitCandidate best{built.map_resolution, 0.0, INFINITY};
     // Every eligible candidate (past the kernel guards) with its model values, for the one-standard-error
-    // rule below; the best is one of them.
+    // rule below, and its gain (empty for plain), to smooth the level with once chosen; the best is one
+    // of them.
     std::vector<std::pair<FitCandidate, std::vector<std::vector<double>>>> eligible;
+    std::vector<SphereMap> eligible_gain;
     std::vector<std::vector<double>> last_values;  // the model values of the candidate graded last
     std::size_t best_at = 0;
-    const auto admit = [&]() {
+    const auto admit = [&](SphereMap gain) {
       eligible.emplace_back(tried.back(), std::move(last_values));
+      eligible_gain.push_back(std::move(gain));
       if (tried.back().cost < best.cost) best = tried.back(), best_at = eligible.size() - 1;
     };
     const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
@@ -953,7 +957,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       const SphereMap sum_at_r = level_sum(at_r);
       set.levels[k] = at_r;
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
-      admit();
+      admit(SphereMap());
+      // The cost of the last two-scale candidate admitted at this R, and whether a wider one may still win.
+      double two_scale_before = INFINITY;
+      bool two_scale_improving = true;
       for (const FitKernel& kernel : set_rays > 0 && !at_r.apls.empty() ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
         // Two-scale keeps the level's sum sharp at a distance, so only where the maps are fine enough to
@@ -963,6 +970,13 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         // fit's standard error of the R 128 candidates: apl_sets.md).
         // On one map it is the sharpened kernel at σ/2, already a candidate.
         if (kernel.mode == KernelMode::two_scale && (R != built.map_resolution || built.size() <= 1)) continue;
+        // Two-scale is tried from its narrowest width up, and a wider one only while widening has helped:
+        // the error is U-shaped in the width (bias grows as noise falls), so once a width graded worse
+        // than the one before, or was refused by a guard (a wider kernel lowers a peak more), a wider one
+        // would only cost a level's smoothing and grading (the box with holes: σ 6.7° graded far worse
+        // than 3.4° at every level, so 10.1° is not tried).
+        if (kernel.mode == KernelMode::two_scale && !two_scale_improving) continue;
+        if (kernel.mode == KernelMode::two_scale) two_scale_improving = false;  // until admitted and better
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where a
         // patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7° lowered the
         // peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10). Kept with the
@@ -987,7 +1001,12 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         for (std::size_t s = 0; s < kernel_errors.size() && s < plain_errors.size(); ++s)
           if (std::isfinite(plain_errors[s]) && plain_errors[s] <= kUnusableError && !(kernel_errors[s] <= plain_errors[s]))
             no_worse = false;
-        if (no_worse) admit();
+        if (!no_worse) continue;
+        if (kernel.mode == KernelMode::two_scale) {
+          two_scale_improving = tried.back().cost < two_scale_before;
+          two_scale_before = tried.back().cost;
+        }
+        admit(gain);
       }
       // Past the minimum: coarser maps trade noise for blur, and once halving made them worse and the best
       // so far is better still, further halving only blurs more (the error is U-shaped in R).
@@ -1006,17 +1025,22 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     const double scale = double(best.resolution) / double(std::max(1, built.map_resolution));
     if (!eligible.empty() && double(built.map_bytes()) * scale * scale > kParsimonyBytes) {
       const std::vector<std::vector<double>>& best_values = eligible[best_at].second;
-      FitCandidate simpler = best;
-      for (const auto& [c, values] : eligible) {
-        if (c.resolution > simpler.resolution) continue;
-        if (!(c.cost <= best.cost + cost_difference_standard_error(ref, best_values, values))) continue;
-        if (c.resolution < simpler.resolution || c.cost < simpler.cost) simpler = c;
+      std::size_t simpler = best_at;
+      for (std::size_t i = 0; i < eligible.size(); ++i) {
+        const FitCandidate& c = eligible[i].first;
+        const FitCandidate& s = eligible[simpler].first;
+        if (c.resolution > s.resolution) continue;
+        if (!(c.cost <= best.cost + cost_difference_standard_error(ref, best_values, eligible[i].second))) continue;
+        if (c.resolution < s.resolution || c.cost < s.cost) simpler = i;
       }
-      best = simpler;
+      best = eligible[simpler].first;
+      best_at = simpler;
     }
     set.levels[k] = downsampled_level(built, best.resolution);
+    // Smoothed with the gain the candidate was graded with (the level sum's at that resolution).
     if (best.kappa > 0)
-      set.levels[k] = smoothed_level(set.levels[k], *kernel_for(best.resolution, best.kappa), 0, best.mode);
+      set.levels[k] = smoothed_level_with_gain(set.levels[k], *kernel_for(best.resolution, best.kappa), best.mode,
+                                               eligible_gain.at(best_at));
     choice.resolution.push_back(best.resolution);
     choice.kappa.push_back(best.kappa);
     choice.mode.push_back(best.kappa > 0 ? best.mode : KernelMode::plain);
