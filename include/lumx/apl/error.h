@@ -914,7 +914,7 @@ inline constexpr double kParsimonyBytes = 1024.0 * 1024.0;
 inline constexpr double kUnusableError = 0.25;
 
 /// Chooses each level's map resolution, from its own down to `min_resolution`, and kernel (none, or one of
-/// fit_kernel_kappas), by the error against `ref` (held-out rays: see above), and fits the levels of `set`.
+/// fit_kernels(R)), by the error against `ref` (held-out rays: see above), and fits the levels of `set`.
 /// `set_rays`: the number of rays `set` was built from (0: unknown, and then no kernel is tried).
 inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradiance& ref, const AplErrorOptions& options,
                                             int min_resolution = 4, std::uint64_t set_rays = 0) {

@@ -75,7 +75,7 @@ class SphereMapKernel {
   /// weights (100 MB).
   static constexpr int kMaxResolution = 128;
   /// Kernels shared() keeps: more than the held-out fit uses (0.75, 1.5 and 3 texel widths at each of R 32,
-  /// 64 and 128, and the two-scale kernels of 2.25 and 4.5 at the level's built resolution: 11, about 460 MB
+  /// 64 and 128, and the two-scale kernels of 2.25 and 4.5 at the level's built resolution: up to 11, 460 MB
   /// when that is R 128, of which 4.5 texel widths holds 2.9·10⁷ weights, 230 MB), since a cache that drops
   /// the oldest and is smaller than the cycle of a level's candidates would rebuild every kernel for every
   /// level.
