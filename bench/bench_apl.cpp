@@ -203,6 +203,8 @@ BENCHMARK(irradiance_random)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
 /// One level of 512 one-channel APLs (as the builder makes them) at map resolution R = range(0): the
 /// cost of a shading point against the size of the maps the held-out fit chooses (R 16–32 for 1 M rays
 /// of smooth emitters) and the rule's R 128. The maps are the box-downsampled copies of one R 128 set.
+/// range(1) = 1 draws them in a turned MapFrame (a beam's, apl_set.h): the cost of turning each
+/// direction before its lookup.
 void irradiance_512_apls_by_resolution(benchmark::State& state) {
   static const AplSet fine = [] {
     AplSet s;
@@ -225,6 +227,7 @@ void irradiance_512_apls_by_resolution(benchmark::State& state) {
   }();
   AplSet set = fine;
   set.levels[0] = downsampled_level(fine.levels[0], int(state.range(0)));
+  if (state.range(1) != 0) set.levels[0].frame = map_frame_for(glm::dvec3(0.2, -0.1, -1.0));
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   std::vector<glm::vec3> points(4096);
@@ -237,7 +240,9 @@ void irradiance_512_apls_by_resolution(benchmark::State& state) {
   }
   state.counters["map_bytes"] = double(set.levels[0].map_bytes());
 }
-BENCHMARK(irradiance_512_apls_by_resolution)->Arg(16)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMicrosecond);
+BENCHMARK(irradiance_512_apls_by_resolution)
+    ->Args({16, 0})->Args({32, 0})->Args({64, 0})->Args({128, 0})->Args({32, 1})->Args({128, 1})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(irradiance_coherent)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
 
 void sample(benchmark::State& state) {

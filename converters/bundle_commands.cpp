@@ -65,8 +65,11 @@ int run_bundle_info(const InfoArgs& a) {
           stored.push_back({{"resolution", p.resolution}, {"bytes", p.bytes}, {"pixel_type", p.pixel_type}});
           disk += p.bytes;
         }
+        json frame = json::array();
+        for (int r = 0; r < 3; ++r) frame.push_back({l.frame.to_map[0][r], l.frame.to_map[1][r], l.frame.to_map[2][r]});
         levels.push_back({{"apls", l.apl_count()},
                           {"map_resolution", l.map_resolution},
+                          {"map_frame", frame},
                           {"stored", stored},
                           {"bytes_on_disk", disk},
                           {"bytes_in_memory", level_memory_bytes(l, m.channels)},
@@ -98,6 +101,20 @@ int run_bundle_info(const InfoArgs& a) {
     std::printf("bounds:      sphere at (%g, %g, %g) m, radius %g m\n", m.bounds.center.x, m.bounds.center.y,
                 m.bounds.center.z, m.bounds.radius);
     for (const auto& [k, v] : m.provenance) std::printf("provenance:  %s = %s\n", k.c_str(), v.c_str());
+    bool one_frame = true;
+    for (const auto& l : m.levels) one_frame = one_frame && l.frame.to_map == m.levels.front().frame.to_map;
+    for (std::size_t k = 0; k < m.levels.size(); ++k) {
+      const lumx::MapFrame& f = m.levels[k].frame;
+      if (k > 0 && f.to_map == m.levels[k - 1].frame.to_map) continue;
+      const std::string which = one_frame ? "" : " (level " + std::to_string(k) + " on)";
+      if (f.is_identity()) {
+        std::printf("map frame:   photometric%s\n", which.c_str());
+      } else {
+        const glm::vec3 mid = f.world_direction(lumx::map_frame_target());
+        std::printf("map frame:   turned%s: photometric direction (%.4f, %.4f, %.4f) lies mid-wedge\n", which.c_str(),
+                    mid.x, mid.y, mid.z);
+      }
+    }
     std::printf("levels:\n  %-5s %6s %6s  %-24s %14s %13s %13s  %s\n", "level", "APLs", "map R", "stored R (pixel type)",
                 (std::string("flux (") + flux_unit + ")").c_str(), "disk bytes", "memory bytes", "error table");
     for (std::size_t k = 0; k < m.levels.size(); ++k) {
@@ -172,7 +189,22 @@ int run_bundle_plot(const PlotArgs& a) {
       lumx::MapImageOptions o;
       o.title = a.title.empty() ? "level " + std::to_string(k) + ", APL " + std::to_string(a.apl) : a.title;
       o.unit = lumx::intensity_unit(m.quantity);
-      lumx::write_sphere_map_image(level.apls[std::size_t(a.apl)].map, a.out, o);
+      const lumx::SphereMap& map = level.apls[std::size_t(a.apl)].map;
+      // The image shows the photometric frame's hemispheres: maps drawn in a turned frame are read at
+      // each texel's direction (bilinear, for display only; the flux printed elsewhere is the stored map's).
+      if (level.frame.is_identity()) {
+        lumx::write_sphere_map_image(map, a.out, o);
+      } else {
+        lumx::SphereMap view(map.resolution(), map.channels());
+        for (int y = 0; y < view.height(); ++y)
+          for (int x = 0; x < view.width(); ++x) {
+            const glm::vec3 w = lumx::sphere_map::uv_to_direction(
+                {(float(x) + 0.5f) / float(view.width()), (float(y) + 0.5f) / float(view.height())});
+            const glm::vec3 v = map.lookup(level.frame.map_direction(w));
+            for (int c = 0; c < view.channels(); ++c) view.at(x, y, c) = v[c];
+          }
+        lumx::write_sphere_map_image(view, a.out, o);
+      }
     } else {
       lumx::AplPlotOptions o;
       o.title = a.title.empty() ? "level " + std::to_string(k) + ": " + std::to_string(level.size()) + " APLs" : a.title;

@@ -65,8 +65,8 @@ double greedy_total_cost(const std::vector<glm::vec3>& p, const std::vector<floa
 }
 
 /// Rays from `emitters` points (each a tiny disc of radius 1 mm), each emitter with its own flux and a
-/// downward cos^k lobe; `per_emitter` rays each, all with equal flux within an emitter.
-MemoryRaySource emitter_rays(int emitters, int per_emitter, unsigned seed, double spread_m = 0.2) {
+/// downward cos^m lobe (m = `lobe`); `per_emitter` rays each, all with equal flux within an emitter.
+MemoryRaySource emitter_rays(int emitters, int per_emitter, unsigned seed, double spread_m = 0.2, int lobe = 2) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   RayChunk rays;
@@ -77,7 +77,8 @@ MemoryRaySource emitter_rays(int emitters, int per_emitter, unsigned seed, doubl
     for (int r = 0; r < per_emitter; ++r) {
       const float rho = 0.001f * std::sqrt(u(rng)), phi = float(2 * kPi) * u(rng);
       const glm::vec3 p = centre + glm::vec3(rho * std::cos(phi), rho * std::sin(phi), 0.0f);
-      const float cos_t = std::pow(u(rng), 1.0f / 3.0f), sin_t = std::sqrt(1 - cos_t * cos_t), az = float(2 * kPi) * u(rng);
+      // I ∝ cos^m θ: cos θ has the density ∝ c^m on [0, 1], drawn as u^(1/(m+1)).
+      const float cos_t = std::pow(u(rng), 1.0f / float(lobe + 1)), sin_t = std::sqrt(1 - cos_t * cos_t), az = float(2 * kPi) * u(rng);
       rays.push_back(p, {sin_t * std::cos(az), sin_t * std::sin(az), -cos_t}, emitter_flux / float(per_emitter));
     }
   }
@@ -221,11 +222,18 @@ TEST(AplBuilder, EmittersBecomeApls) {
     const int e = int(std::lround(std::fmod(angle + 2 * kPi, 2 * kPi) / (2 * kPi) * 8)) % 8;
     EXPECT_NEAR(glm::length(glm::vec2(a.position)), 0.2f, 0.002f);
     EXPECT_NEAR(a.flux.x, 10.0 * (e + 1), 1e-6 * flux) << "emitter " << e;
-    // Its map is the emitter's cos² lobe: all light goes down, and its peak is near nadir.
+    // Its map is the emitter's cos² lobe: all light goes down. The maps are drawn turned (MapFrame), so
+    // "down" is each texel's photometric direction, and a texel the horizon cuts (centre within half a
+    // texel diagonal of it) may hold light on either side.
     const SphereMap& m = a.map;
+    const float margin = std::sqrt(float(m.texel_solid_angle()));
     double down = 0;
     for (int y = 0; y < m.height(); ++y)
-      for (int x = m.width() / 2; x < m.width(); ++x) down += m.at(x, y, 0);
+      for (int x = 0; x < m.width(); ++x) {
+        const glm::vec3 w = set.levels[1].frame.world_direction(
+            sphere_map::uv_to_direction({(float(x) + 0.5f) / float(m.width()), (float(y) + 0.5f) / float(m.height())}));
+        if (w.z < margin) down += m.at(x, y, 0);
+      }
     EXPECT_NEAR(down * m.texel_solid_angle(), a.flux.x, 1e-6 * a.flux.x);
   }
   EXPECT_EQ(report.rays, 32000u);
@@ -306,6 +314,69 @@ TEST(AplBuilder, SameInputGivesByteIdenticalBundles) {
   EXPECT_EQ(manifests[2], manifests[3]);
   EXPECT_NE(manifests[0], manifests[2]);  // the smoothing did change the maps
   fs::remove_all(root);
+}
+
+TEST(AplBuilder, MapsAreTurnedSoTheBeamLiesInsideAWedge) {
+  // Downward cos^20 beams: the flux-weighted mean direction is nadir, which the photometric frame puts at
+  // the lower square's centre, where the concentric map's four wedges meet. The builder turns it onto
+  // map_frame_target() (mid-wedge), the same frame for every level.
+  MemoryRaySource rays = emitter_rays(8, 4000, 7, 0.2, 20);
+  glm::dvec3 mean(0.0);
+  rays.rewind();
+  RayChunk c;
+  while (rays.next(c, 4096))
+    for (std::size_t i = 0; i < c.size(); ++i) mean += double(c.flux[i]) * glm::dvec3(c.direction(i));
+  AplBuildOptions o;
+  o.level_counts = {1, 8, 64};
+  const AplSet set = build_apl_set(rays, o);
+  ASSERT_TRUE(check_apl_set(set).empty());
+  const glm::vec3 turned = set.levels[0].frame.map_direction(glm::vec3(glm::normalize(mean)));
+  EXPECT_GT(glm::dot(turned, map_frame_target()), 1.0f - 1e-6f);
+  EXPECT_LT(glm::length(glm::normalize(mean) - glm::dvec3(0, 0, -1)), 0.02);  // the lobes' mean is nadir
+  for (const AplLevel& l : set.levels) EXPECT_TRUE(l.frame.to_map == set.levels[0].frame.to_map);
+  // The maps hold the rays' far field in photometric directions: the first and second moments of the
+  // level-0 map, summed over texels at their centres' photometric directions, match the rays' own, as
+  // they do for the same rays binned in the photometric frame. A texel centre is off its rays by at most
+  // half a texel diagonal (R 32: 3.2°), and a smooth moment's error is second order in that offset,
+  // ~0.3 % of the flux; 1 % allows for it.
+  double total = 0, zz = 0;
+  rays.rewind();
+  while (rays.next(c, 4096))
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      total += c.flux[i];
+      zz += double(c.flux[i]) * double(c.direction(i).z) * double(c.direction(i).z);
+    }
+  o.orient_maps = false;
+  const AplSet plain = build_apl_set(rays, o);
+  EXPECT_TRUE(plain.levels[0].frame.is_identity());
+  for (const AplSet* s : {&set, &plain}) {
+    const AplLevel& l = s->levels[0];
+    const SphereMap& m = l.apls[0].map;
+    glm::dvec3 first(0.0);
+    double second = 0;
+    for (int y = 0; y < m.height(); ++y)
+      for (int x = 0; x < m.width(); ++x) {
+        const glm::dvec3 w(l.frame.world_direction(
+            sphere_map::uv_to_direction({(float(x) + 0.5f) / float(m.width()), (float(y) + 0.5f) / float(m.height())})));
+        first += double(m.at(x, y, 0)) * m.texel_solid_angle() * w;
+        second += double(m.at(x, y, 0)) * m.texel_solid_angle() * w.z * w.z;
+      }
+    EXPECT_LT(glm::length(first - mean), 0.01 * total) << (s == &set ? "turned" : "photometric");
+    EXPECT_NEAR(second, zz, 0.01 * total) << (s == &set ? "turned" : "photometric");
+  }
+  // Broader light (mean resultant below kMinMapFrameResultant) keeps the photometric frame: light spread
+  // evenly, and the cos² lobes (mean resultant 3/4) whose horizon the photometric frame keeps on the map's
+  // equator.
+  std::mt19937 rng(4);
+  std::normal_distribution<float> g;
+  RayChunk even;
+  for (int i = 0; i < 20000; ++i) even.push_back({0, 0, 0}, glm::normalize(glm::vec3(g(rng), g(rng), g(rng))), 1.0f);
+  MemoryRaySource even_rays(std::move(even), RaysetInfo{});
+  o.orient_maps = true;
+  o.level_counts = {1, 8};
+  EXPECT_TRUE(build_apl_set(even_rays, o).levels[0].frame.is_identity());
+  MemoryRaySource broad = emitter_rays(8, 4000, 7);
+  EXPECT_TRUE(build_apl_set(broad, o).levels[0].frame.is_identity());
 }
 
 TEST(RayFarField, MatchesTheAnalyticLobeAndLevelOne) {
@@ -460,11 +531,12 @@ TEST(AplBuilder, SmoothingKeepsEveryAplsFluxAndReducesItsNoise) {
   // Noise: the 8-APL maps are each one emitter's cos² lobe (I ∝ cos² θ below, 0 above), 3000 rays over
   // 2048 texels. Smoothed with 16 rays per child, their texels are closer to it than the raw histogram's
   // (relative RMS over all texels).
-  auto rms_error = [](const SphereMap& m, double flux) {
+  auto rms_error = [](const SphereMap& m, const MapFrame& frame, double flux) {
     double se = 0, st = 0;
     for (int y = 0; y < m.height(); ++y)
       for (int x = 0; x < m.width(); ++x) {
-        const glm::vec3 w = sphere_map::uv_to_direction({(float(x) + 0.5f) / float(m.width()), (float(y) + 0.5f) / float(m.height())});
+        const glm::vec3 w = frame.world_direction(
+            sphere_map::uv_to_direction({(float(x) + 0.5f) / float(m.width()), (float(y) + 0.5f) / float(m.height())}));
         const double truth = w.z < 0 ? flux * 3.0 / (2.0 * kPi) * double(w.z) * double(w.z) : 0.0;  // ∫ = flux
         se += (m.at(x, y, 0) - truth) * (m.at(x, y, 0) - truth);
         st += truth * truth;
@@ -473,8 +545,8 @@ TEST(AplBuilder, SmoothingKeepsEveryAplsFluxAndReducesItsNoise) {
   };
   double raw_err = 0, smooth_err = 0;
   for (std::size_t a = 0; a < 8; ++a) {
-    raw_err += rms_error(raw.levels[1].apls[a].map, raw.levels[1].apls[a].flux.x);
-    smooth_err += rms_error(smooth.levels[1].apls[a].map, smooth.levels[1].apls[a].flux.x);
+    raw_err += rms_error(raw.levels[1].apls[a].map, raw.levels[1].frame, raw.levels[1].apls[a].flux.x);
+    smooth_err += rms_error(smooth.levels[1].apls[a].map, smooth.levels[1].frame, smooth.levels[1].apls[a].flux.x);
   }
   // Measured: 0.44 raw, 0.24 smoothed (≈ 1/√16 per reliable child, plus the prior's bias).
   EXPECT_LT(smooth_err, 0.65 * raw_err) << raw_err / 8 << " " << smooth_err / 8;

@@ -14,7 +14,7 @@ using namespace lumx;
 
 namespace {
 
-AplSet lobes(int n, ChannelLayout channels, unsigned seed) {
+AplSet lobes(int n, ChannelLayout channels, unsigned seed, const MapFrame& frame = {}) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   AplSet set;
@@ -22,6 +22,7 @@ AplSet lobes(int n, ChannelLayout channels, unsigned seed) {
   set.bounds.radius = 0.5;
   AplLevel level;
   level.map_resolution = 16;
+  level.frame = frame;
   const int nc = channel_count(channels);
   for (int i = 0; i < n; ++i) {
     Apl a;
@@ -63,8 +64,12 @@ glm::dvec3 bilinear_flux(const AplLevel& level) {
 }  // namespace
 
 TEST(AplSampling, EmissionSamplesAreUnbiasedAndTheirPdfsConsistent) {
+  // In the photometric frame and in a turned one (the builder's, for a beam): the samples are turned to
+  // photometric directions, and pdf() of that direction is the sample's density bit for bit.
+  const MapFrame turned = map_frame_for(glm::dvec3(-0.1, 0.2, -1.0));
+  for (const MapFrame& frame : {MapFrame{}, turned})
   for (ChannelLayout layout : {ChannelLayout::luminance, ChannelLayout::rgb}) {
-    const AplSet set = lobes(12, layout, 1);
+    const AplSet set = lobes(12, layout, 1, frame);
     const AplEmissionSampler sampler(set, 0);
     const glm::dvec3 expected = bilinear_flux(set.levels[0]);
     std::mt19937 rng(2);

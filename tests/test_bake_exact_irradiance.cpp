@@ -278,9 +278,11 @@ TEST(BakeExactIrradiance, BakedParaboloidBeamStaysInItsCone) {
               "at 30 deg (1 cd direct), maps R %d\n",
               t.flux_lm(), 100 * outside, axis, off_axis, r.bundle.far_field_resolution);
   EXPECT_LT(outside, 0.01);
-  // Every particle leaves (4π lm); measured +1.6 %: the axis spike tabulated on the 2.5° × 1° Type C grid
-  // and integrated bilinearly.
-  EXPECT_NEAR(t.flux_lm(), 4 * lumx::kPi, 0.03 * 4 * lumx::kPi);
+  // Every particle leaves (4π lm); measured +3.9 %: the axis spike, 10 lm in about one texel of the R 64
+  // maps (2.2°), tabulated on the 2.5° × 1° Type C grid and integrated bilinearly, so its integral depends
+  // on where the texel falls between the grid's rings (+1.6 % with the maps drawn in the photometric
+  // frame, the spike at the map's pole; the builder's MapFrame puts it mid-wedge).
+  EXPECT_NEAR(t.flux_lm(), 4 * lumx::kPi, 0.05 * 4 * lumx::kPi);
   // 10 lm reflected into the axis texel (4π / 2R² sr) against the point's own 1 cd beside it.
   EXPECT_GT(axis, 50 * off_axis);
   EXPECT_NEAR(off_axis, 1.0, 0.3);  // the direct light: 1 cd, within the maps' noise at ~1 000 rays a texel

@@ -4,6 +4,7 @@
 // and located rejection of corrupted, truncated, inconsistent or hostile bundles.
 #include <lumx/apl/far_field.h>
 #include <lumx/apl/apl_set.h>
+#include <lumx/apl/evaluation.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/volume/radiance_volume.h>
@@ -403,7 +404,8 @@ TEST(Bundle, InconsistentOrHostileManifestsAreRejected) {
   expect([](auto& j) { j["levels"][0]["maps"][0]["file"] = "../../etc/passwd"; }, "/levels/0/maps/0/file");
   expect([](auto& j) { j["levels"][0]["maps"][0]["sha256"] = "abc"; }, "/levels/0/maps/0/sha256");
   expect([](auto& j) { j["levels"][0]["maps"][1]["resolution"] = 3; }, "/levels/0/maps/1/resolution");
-  expect([](auto& j) { j["format_version"] = 2; }, "/format_version");
+  expect([](auto& j) { j["format_version"] = 3; }, "/format_version");
+  expect([](auto& j) { j["format_version"] = 0; }, "/format_version");
   expect([](auto& j) { j["units"]["intensity"] = "W/sr"; }, "/units/flux");
   expect([](auto& j) { j["channels"] = {"R", "G"}; }, "/channels");
   expect([](auto& j) { j.erase("levels"); }, "/levels");
@@ -434,6 +436,51 @@ TEST(Bundle, InconsistentOrHostileManifestsAreRejected) {
   EXPECT_NE(load_error(big).find("manifest.json"), std::string::npos);
   expect([](auto& j) { j["levels"][0]["surprise"] = 1; }, "/levels/0/surprise");
   expect([](auto& j) { j["units"]["colour"] = "red"; }, "/units/colour");
+}
+
+TEST(Bundle, MapFramesRoundTripAndAreChecked) {
+  // A turned frame on every level (as the builder writes a beam's maps) is stored bit for bit, and the
+  // levels read back look up the same intensity in every photometric direction.
+  AplSet set = three_level_set(16, ChannelLayout::luminance);
+  const MapFrame frame = map_frame_for(glm::dvec3(0.2, -0.1, -1.0));
+  for (AplLevel& l : set.levels) l.frame = frame;
+  const fs::path root = scratch("frames");
+  const fs::path good = root / "turned.lumx";
+  BundleWriteOptions exact;
+  exact.pixel_type = MapPixelType::float32;  // texels bit for bit, so lookups can be compared exactly
+  write_bundle(good.string(), set, nullptr, exact);
+  const nlohmann::json m = read_manifest(good);
+  EXPECT_EQ(m["format_version"], 2);
+  ASSERT_TRUE(m["levels"][0].contains("map_frame"));
+  const BundleReader reader(good.string());
+  for (std::size_t k = 0; k < set.levels.size(); ++k) {
+    const AplLevel back = reader.load_level(k);
+    EXPECT_TRUE(back.frame.to_map == frame.to_map) << k;
+    ASSERT_EQ(back.size(), set.levels[k].size());
+    const std::size_t i = back.size() - 1;
+    for (const glm::vec3& w : {glm::vec3(0, 0, -1), glm::normalize(glm::vec3(0.3f, 0.4f, -0.8f)), glm::vec3(1, 0, 0)})
+      EXPECT_EQ(intensity(back, back.apls[i], w).x, intensity(set.levels[k], set.levels[k].apls[i], w).x) << k;
+  }
+  ManifestEdits expect{root, good, m};
+  expect([](auto& j) { j["levels"][1]["map_frame"][2][0] = 0.5; }, "/levels/1/map_frame");   // not a rotation
+  expect([](auto& j) {  // a reflection: orthonormal, determinant −1
+    for (int c = 0; c < 3; ++c) j["levels"][0]["map_frame"][2][c] = -double(j["levels"][0]["map_frame"][2][c]);
+  }, "/levels/0/map_frame");
+  expect([](auto& j) { j["levels"][2]["map_frame"][1] = {1, 2}; }, "/levels/2/map_frame/1");
+  expect([](auto& j) { j["levels"][0]["map_frame"][0][0] = "1"; }, "/levels/0/map_frame/0/0");
+  expect([](auto& j) { j["levels"][0]["map_frame"][0][0] = 1e300; }, "/levels/0/map_frame");  // inf as float
+  expect([](auto& j) { j["format_version"] = 1; }, "/levels/0/map_frame");  // version 1 has no frames
+  // A version 1 bundle (no frames) is read with the photometric frame.
+  const AplSet plain = three_level_set(16, ChannelLayout::luminance);
+  const fs::path old = root / "version1.lumx";
+  write_bundle(old.string(), plain);
+  nlohmann::json j1 = read_manifest(old);
+  EXPECT_FALSE(j1["levels"][0].contains("map_frame"));
+  j1["format_version"] = 1;
+  write_manifest(old, j1);
+  const BundleReader r1(old.string());
+  EXPECT_EQ(r1.manifest().format_version, 1);
+  EXPECT_TRUE(r1.load_level(2).frame.is_identity());
 }
 
 TEST(Bundle, VolumeManifestRulesAreEnforced) {

@@ -234,6 +234,9 @@ class Level:
     @property
     def map_resolution(self) -> int: ...
     @property
+    def map_frame(self) -> npt.NDArray[np.float32]:
+        """(3, 3) rotation: the maps are read at map_frame @ w for a photometric direction w"""
+    @property
     def positions(self) -> npt.NDArray[np.float32]:
         """(N, 3), m"""
     @property

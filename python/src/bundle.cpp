@@ -136,6 +136,7 @@ class Bundle {
     for (const lumx::BundleLevelInfo& info : m.levels) {
       lumx::AplLevel level;
       level.map_resolution = info.map_resolution;
+      level.frame = info.frame;
       level.apls.resize(info.apl_count());
       level.error = info.error;
       skeleton_.levels.push_back(std::move(level));
@@ -291,6 +292,18 @@ void bind_bundle(py::module_& m) {
           "map_resolution", [](const Level& l) { return l.data->level().map_resolution; },
           "R of the loaded maps (each map is an R x 2R image)")
       .def_property_readonly(
+          "map_frame",
+          [](const Level& l) {
+            const glm::mat3& to_map = l.data->level().frame.to_map;
+            py::array_t<float> out({py::ssize_t(3), py::ssize_t(3)});
+            float* o = out.mutable_data();
+            for (int r = 0; r < 3; ++r)
+              for (int c = 0; c < 3; ++c) o[3 * r + c] = to_map[c][r];
+            return out;
+          },
+          "3 x 3 rotation from the photometric frame to the maps' frame: a direction w reads the maps at "
+          "map_frame @ w, and a map direction m is the photometric direction map_frame.T @ m")
+      .def_property_readonly(
           "positions",
           [](const Level& l) {
             const auto& apls = l.data->level().apls;
@@ -336,7 +349,7 @@ void bind_bundle(py::module_& m) {
       .def("map", &map_view, py::arg("apl"),
            "APL `apl`'s intensity map, cd or W/sr, as a read-only (R, 2R, channels) float32 view (no copy); "
            "texel (x, y) holds the mean over its equal solid angle 4 pi / (2 R^2) sr. lumx.uv_to_direction "
-           "maps texel centres to directions.")
+           "maps texel centres to directions of the maps' frame (map_frame.T turns them photometric).")
       .def(
           "maps",
           [](const Level& l) {

@@ -138,13 +138,16 @@ def test_intensity_at_texel_centres_integrates_to_the_maps(built):
     level = b.load_level(2)
     R = level.map_resolution
     xs, ys = np.meshgrid((np.arange(2 * R) + 0.5) / (2 * R), (np.arange(R) + 0.5) / R)
-    w = lumx.uv_to_direction(np.stack([xs, ys], axis=-1).reshape(-1, 2))
+    m = lumx.uv_to_direction(np.stack([xs, ys], axis=-1).reshape(-1, 2))  # in the maps' frame
+    frame = level.map_frame
+    np.testing.assert_allclose(frame @ frame.T, np.eye(3), atol=1e-6)
+    w = m @ frame  # photometric directions: map_frame.T @ m per row
     # A bilinear lookup at a texel centre is that texel: the sum over centres is the maps' integral.
     total = float(np.sum(level.intensity(w))) * 4 * math.pi / (2 * R * R)
     maps = float(level.maps().sum(dtype=np.float64)) * 4 * math.pi / (2 * R * R)
     assert total == pytest.approx(maps, rel=1e-5)
     np.testing.assert_allclose(b.intensity(w[:10], level=2), level.intensity(w[:10]), rtol=1e-12)
-    np.testing.assert_allclose(lumx.direction_to_uv(w[:5]), np.stack([xs, ys], axis=-1).reshape(-1, 2)[:5],
+    np.testing.assert_allclose(lumx.direction_to_uv(m[:5]), np.stack([xs, ys], axis=-1).reshape(-1, 2)[:5],
                                atol=1e-6)
 
 

@@ -18,11 +18,13 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 LUMX_NAMESPACE_BEGIN
@@ -32,7 +34,7 @@ struct Apl {
   glm::vec3 position{0.0f};  ///< m, in the luminaire's photometric frame
   glm::dvec3 flux{0.0};      ///< lm or W per channel (one-channel sets repeat Y); equals map.integral()
   int parent = -1;           ///< index of the APL in the previous (coarser) level; −1 in the first level
-  SphereMap map;             ///< intensity, cd or W/sr per channel
+  SphereMap map;             ///< intensity, cd or W/sr per channel, in its level's MapFrame
 };
 
 /// Relative RMSE of a level's irradiance against a reference, on spheres of relative distance d
@@ -43,8 +45,61 @@ struct ErrorTable {
   bool empty() const { return relative_distance.empty(); }
 };
 
+/// The rotation from the luminaire's photometric frame to the frame its maps are drawn in. An equal-area
+/// square map has kinks where its wedges meet (math/sphere_map.h: the poles and the squares' diagonals),
+/// and a lobe centred on one is read through them: noise-free, a cos^50 lobe along a pole is 4.7 % off
+/// (eq. 5.1) from R 128 texels read bilinearly, against 1.4 % inside a wedge (apl_sets.md). The builder
+/// turns a set's maps so that its rays' mean direction falls inside a wedge (map_frame_for); sets from
+/// far-field photometry keep the identity.
+struct MapFrame {
+  glm::mat3 to_map{1.0f};  ///< world → map; orthonormal, determinant +1 (glm is column-major)
+
+  glm::vec3 map_direction(const glm::vec3& w) const { return to_map * w; }
+  glm::vec3 world_direction(const glm::vec3& m) const { return glm::transpose(to_map) * m; }
+  bool is_identity() const { return to_map == glm::mat3(1.0f); }
+  /// Largest |(RᵀR − I)_ij| and the determinant: how far from a proper rotation the matrix is.
+  std::pair<float, float> deviation() const {
+    const glm::mat3 p = glm::transpose(to_map) * to_map;
+    float worst = 0;
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) worst = std::max(worst, std::abs(p[c][r] - (c == r ? 1.0f : 0.0f)));
+    return {worst, glm::determinant(to_map)};
+  }
+};
+
+/// The direction a set's maps are turned to: polar angle 45° on the +x meridian of the upper square, the
+/// middle of a wedge of the concentric map, away from its centre, its diagonals and its border.
+inline glm::vec3 map_frame_target() { return glm::vec3(std::sqrt(0.5f), 0.0f, std::sqrt(0.5f)); }
+
+/// The frame that turns unit direction `mean` onto map_frame_target() by the shortest rotation (Rodrigues),
+/// or the identity when `mean` is not a usable direction (zero, not finite).
+inline MapFrame map_frame_for(const glm::dvec3& mean) {
+  MapFrame f;
+  const double len = glm::length(mean);
+  if (!(len > 0) || !std::isfinite(len)) return f;
+  const glm::dvec3 a = mean / len, b(map_frame_target());
+  const glm::dvec3 axis = glm::cross(a, b);
+  const double s = glm::length(axis), c = glm::dot(a, b);
+  glm::dvec3 k;
+  if (s > 1e-9) {
+    k = axis / s;
+  } else if (c > 0) {
+    return f;  // already there
+  } else {     // opposite: half a turn about any axis perpendicular to b
+    k = glm::normalize(glm::cross(b, std::abs(b.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
+  }
+  // R = I cos θ + sin θ [k]× + (1 − cos θ) k kᵀ, with cos θ = a·b and sin θ = |a × b|.
+  const double cs = s > 1e-9 ? c : -1.0, sn = s > 1e-9 ? s : 0.0;
+  glm::dmat3 r(0.0);
+  const glm::dmat3 kx(0, k.z, -k.y, -k.z, 0, k.x, k.y, -k.x, 0);  // columns of the cross-product matrix
+  r = glm::dmat3(cs) + sn * kx + (1 - cs) * glm::outerProduct(k, k);
+  f.to_map = glm::mat3(r);
+  return f;
+}
+
 struct AplLevel {
   int map_resolution = 0;  ///< R of every map in this level (image 2R × R)
+  MapFrame frame;          ///< the frame every map of this level is drawn in
   std::vector<Apl> apls;
   ErrorTable error;
 
@@ -124,6 +179,10 @@ inline std::vector<std::string> check_apl_set(const AplSet& set, double flux_tol
     if (k > 0 && level.apls.size() <= set.levels[k - 1].apls.size())
       out.push_back(where + ": APL count " + std::to_string(level.apls.size()) +
                     " does not exceed the previous level's");
+    const auto [frame_off, frame_det] = level.frame.deviation();
+    if (!(frame_off <= 1e-4f) || !(std::abs(frame_det - 1.0f) <= 1e-4f))
+      out.push_back(where + ".frame: not a rotation (|RᵀR − I| " + std::to_string(frame_off) + ", determinant " +
+                    std::to_string(frame_det) + ")");
     const ErrorTable& e = level.error;
     bool table_ok = e.relative_rmse.size() == e.relative_distance.size() && e.relative_distance.size() <= 4096;
     for (std::size_t j = 0; table_ok && j < e.relative_distance.size(); ++j)

@@ -680,7 +680,16 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
 // measurement spheres against held-out rays moved to the patch centres (centred_reference), and the one
 // with the least Σ_d log ε(d) (the geometric mean over the distances, so that each distance counts by its
 // relative change: a one-APL level is hopeless near a spot whatever its maps, and a plain sum would let
-// that decide its far field) is the best; the coarsest resolution with a candidate within one standard
+// that decide its far field) is the best. For level 0, the far-field point, the sum runs over the
+// distances where a point can serve: those where its maps as built (plain, at the built resolution) are
+// within kUnusableError (25 %), or every distance when there are none. There the geometric mean still let
+// the near field decide: a cos^20 spot's one-APL level chose R 32 unsmoothed, a point or two better at
+// d = 2 and 5 (where its blur happens to mimic the 2 cm source's extent), and was 10.9 % off at d = 10
+// against 3.0 % for R 128 sharpened, the far field's own choice. (Applied to every level, the rule also
+// dropped d = 0.5 from an LED strip's middle levels, 72 % off there; with that sphere gone the one-
+// standard-error rule no longer found R 32 as good as R 64 or R 64 as good as R 128, and the 10 M-ray
+// bundle grew from 13.6 to 25.6 MB and its build from 82 to 94 s, for held-out errors the rays cannot
+// tell apart.) the coarsest resolution with a candidate within one standard
 // error of it is kept (the one-standard-error rule in fit_map_resolutions). (The noise variance of the
 // reference is the same for every candidate, so the raw ε ranks them.) The
 // choice is made on a set built from half the rays; a set from all of them has half the noise variance
@@ -872,11 +881,14 @@ inline std::pair<double, double> kernel_peak_change(const AplLevel& level, const
 /// noise floor. The spheres share their patch layout and the same rays cross matching patches of every
 /// sphere, so the terms are summed over the spheres per patch and the variance taken of that sum over the
 /// N patches: var_p(Σ_s δ_s,p / (2 m_s² ε̄_s²)) / N. Spheres where either error is not finite and positive
-/// are left out, as in the cost; so are spheres whose patch count differs from the first's.
+/// are left out, as in the cost; so are spheres whose patch count differs from the first's, and those
+/// `spheres` marks false (the distances the cost leaves out; empty: none).
 inline double cost_difference_standard_error(const ReferenceIrradiance& ref, const std::vector<std::vector<double>>& a,
-                                             const std::vector<std::vector<double>>& b) {
+                                             const std::vector<std::vector<double>>& b,
+                                             const std::vector<bool>& spheres = {}) {
   std::vector<double> per_patch;
   for (std::size_t s = 0; s < ref.sphere.size() && s < a.size() && s < b.size(); ++s) {
+    if (s < spheres.size() && !spheres[s]) continue;
     const std::vector<double>& e = ref.sphere[s].irradiance;
     const std::size_t n = e.size();
     if (n < 2 || a[s].size() != n || b[s].size() != n) continue;
@@ -933,6 +945,9 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     std::vector<SphereMap> eligible_gain;
     std::vector<std::vector<double>> last_values;  // the model values of the candidate graded last
     std::size_t best_at = 0;
+    // The distances the cost sums over (see above): every one, except for level 0, where the first
+    // grade (the built maps unsmoothed) sets them.
+    std::vector<bool> serves;
     const auto admit = [&](SphereMap gain) {
       eligible.emplace_back(tried.back(), std::move(last_values));
       eligible_gain.push_back(std::move(gain));
@@ -941,12 +956,15 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
       LevelErrors row = evaluate_level(set, k, ref, o);
       last_values = std::move(row.irradiance);
-      double cost = 0;
       errors.clear();
-      for (const IrradianceErrors& e : row.errors) {
-        errors.push_back(e.relative_rmse);
-        if (std::isfinite(e.relative_rmse) && e.relative_rmse > 0) cost += std::log(e.relative_rmse);
+      for (const IrradianceErrors& e : row.errors) errors.push_back(e.relative_rmse);
+      if (serves.empty()) {
+        for (double e : errors) serves.push_back(k > 0 || (std::isfinite(e) && e <= kUnusableError));
+        if (std::find(serves.begin(), serves.end(), true) == serves.end()) serves.assign(errors.size(), true);
       }
+      double cost = 0;
+      for (std::size_t s = 0; s < errors.size(); ++s)
+        if ((s >= serves.size() || serves[s]) && std::isfinite(errors[s]) && errors[s] > 0) cost += std::log(errors[s]);
       tried.push_back({R, kappa, cost, mode});
       return cost;
     };
@@ -1030,7 +1048,8 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         const FitCandidate& c = eligible[i].first;
         const FitCandidate& s = eligible[simpler].first;
         if (c.resolution > s.resolution) continue;
-        if (!(c.cost <= best.cost + cost_difference_standard_error(ref, best_values, eligible[i].second))) continue;
+        if (!(c.cost <= best.cost + cost_difference_standard_error(ref, best_values, eligible[i].second, serves)))
+          continue;
         if (c.resolution < s.resolution || c.cost < s.cost) simpler = i;
       }
       best = eligible[simpler].first;

@@ -20,13 +20,17 @@
 
 LUMX_NAMESPACE_BEGIN
 
-/// Intensity of one APL toward unit direction w (cd or W/sr per channel; bilinear on its map).
-inline glm::vec3 intensity(const Apl& apl, const glm::vec3& w) { return apl.map.lookup(w); }
+/// Intensity of one APL of `level` toward unit direction w of the photometric frame (cd or W/sr per
+/// channel; bilinear on its map, read in the level's map frame).
+inline glm::vec3 intensity(const AplLevel& level, const Apl& apl, const glm::vec3& w) {
+  return apl.map.lookup(level.frame.map_direction(w));
+}
 
 /// Intensity of a whole level toward w in the far-field limit (positions ignored): Σ_i I_i(w).
 inline glm::dvec3 far_field_intensity(const AplLevel& level, const glm::vec3& w) {
+  const glm::vec3 m = level.frame.map_direction(w);
   glm::dvec3 sum(0.0);
-  for (const Apl& a : level.apls) sum += glm::dvec3(a.map.lookup(w));
+  for (const Apl& a : level.apls) sum += glm::dvec3(a.map.lookup(m));
   return sum;
 }
 
@@ -63,6 +67,7 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
   // texels), then the blends. With hundreds of maps in DRAM the misses of a chunk overlap instead of
   // being paid one after another (performance.md §3c: the limit is misses in flight, not bandwidth).
   constexpr std::size_t kChunk = 32;
+  const glm::mat3 to_map = level.frame.to_map;
   SphereMap::Footprint footprints[kChunk];
   float weights[kChunk];
   std::size_t index[kChunk];
@@ -84,7 +89,7 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
       if (cosine <= 0.0f) continue;
       const float v = visibility(i, a.position, x);
       if (v <= 0.0f) continue;
-      footprints[count] = a.map.footprint(w);
+      footprints[count] = a.map.footprint(to_map * w);
       for (const float* t : footprints[count].texel) __builtin_prefetch(t);
       weights[count] = cosine * v / r2;
       index[count] = i;

@@ -61,17 +61,26 @@ class AplEmissionSampler {
     s.pdf_apl = float(choose_.probability(s.apl));
     const Apl& a = level_->apls[s.apl];
     s.position = a.position;
+    // Drawn in the level's map frame and turned to the photometric frame (a rotation keeps solid angle,
+    // so the density is the same in both). The density and intensity are then read at the turned
+    // direction turned back, exactly as pdf() and a renderer's lookup read it, so that MIS weights agree
+    // with the sample bit for bit; rounding can move that direction into a neighbouring texel only
+    // within ~1e-7 rad of a texel edge.
     const DirectionSample d = samplers_[s.apl].sample(u1, u2);
-    s.direction = d.direction;
-    s.pdf_direction = d.pdf;
-    if (s.valid()) s.flux = a.map.lookup(s.direction) / (s.pdf_apl * s.pdf_direction);
+    if (!(d.pdf > 0)) return s;
+    s.direction = level_->frame.world_direction(d.direction);
+    const glm::vec3 m = level_->frame.map_direction(s.direction);
+    s.pdf_direction = samplers_[s.apl].pdf(m);
+    if (s.valid()) s.flux = a.map.lookup(m) / (s.pdf_apl * s.pdf_direction);
     return s;
   }
 
   /// Probability of choosing APL i.
   float pdf_apl(std::size_t i) const { return float(choose_.probability(i)); }
   /// Solid-angle density of direction w given APL i.
-  float pdf_direction(std::size_t i, const glm::vec3& w) const { return samplers_.at(i).pdf(w); }
+  float pdf_direction(std::size_t i, const glm::vec3& w) const {
+    return samplers_.at(i).pdf(level_->frame.map_direction(w));
+  }
   /// Joint density: pdf_apl(i) · pdf_direction(i, w); equals the product returned by sample().
   float pdf(std::size_t i, const glm::vec3& w) const { return pdf_apl(i) * pdf_direction(i, w); }
 

@@ -38,7 +38,10 @@ LUMX_NAMESPACE_BEGIN
 class RadianceVolume;
 
 namespace bundle {
-inline constexpr int kFormatVersion = 1;
+inline constexpr int kFormatVersion = 2;
+/// The oldest format version this lumx reads. Version 2 added a level's optional "map_frame"; a version 1
+/// bundle's maps are in the photometric frame.
+inline constexpr int kOldestFormatVersion = 1;
 inline constexpr const char* kFormatName = "lumx-bundle";
 inline constexpr const char* kManifestName = "manifest.json";
 }  // namespace bundle
@@ -61,6 +64,7 @@ struct BundleAttachment {
 
 struct BundleLevelInfo {
   int map_resolution = 0;              ///< full resolution R of this level's maps
+  MapFrame frame;                      ///< the frame the maps are drawn in (identity when not stored)
   std::vector<glm::vec3> position;     ///< m, one per APL
   std::vector<glm::dvec3> flux;        ///< lm or W per channel, one per APL
   std::vector<int> parent;             ///< index in the previous level, −1 in the first

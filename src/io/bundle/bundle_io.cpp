@@ -203,6 +203,7 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
       const AplLevel& level = set.levels[k];
       BundleLevelInfo info;
       info.map_resolution = level.map_resolution;
+      info.frame = level.frame;
       info.error = level.error;
       for (const Apl& a : level.apls) {
         info.position.push_back(a.position);
@@ -420,6 +421,7 @@ AplLevel BundleReader::load_level(std::size_t k, int max_resolution) const {
 
   AplLevel level;
   level.map_resolution = R;
+  level.frame = info.frame;
   level.error = info.error;
   level.apls.resize(n);
   const int nc = channel_count(manifest_.channels);

@@ -163,6 +163,12 @@ std::string manifest_to_json(const BundleManifest& m) {
     json level;
     level["apl_count"] = l.apl_count();
     level["map_resolution"] = l.map_resolution;
+    if (!l.frame.is_identity()) {  // rows: the map's axes in the photometric frame
+      json rows = json::array();
+      for (int r = 0; r < 3; ++r)
+        rows.push_back(json::array({double(l.frame.to_map[0][r]), double(l.frame.to_map[1][r]), double(l.frame.to_map[2][r])}));
+      level["map_frame"] = rows;
+    }
     json pos = json::array(), flux = json::array();
     for (const glm::vec3& p : l.position) pos.push_back(json::array({p.x, p.y, p.z}));
     for (const glm::dvec3& f : l.flux) {
@@ -242,8 +248,9 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   if (r.string(r.member(j, "", "format"), "/format") != bundle::kFormatName)
     r.fail("/format", std::string("not \"") + bundle::kFormatName + "\"");
   m.format_version = int(r.integer(r.member(j, "", "format_version"), "/format_version", 1, 1 << 20));
-  if (m.format_version != bundle::kFormatVersion)
+  if (m.format_version < bundle::kOldestFormatVersion || m.format_version > bundle::kFormatVersion)
     r.fail("/format_version", "version " + std::to_string(m.format_version) + " is not supported (this lumx reads " +
+                                  std::to_string(bundle::kOldestFormatVersion) + " to " +
                                   std::to_string(bundle::kFormatVersion) + ")");
   m.generator = r.string(r.member(j, "", "generator"), "/generator");
 
@@ -286,13 +293,25 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   for (std::size_t k = 0; k < levels.size(); ++k) {
     const std::string at = "/levels/" + std::to_string(k);
     const json& lj = levels[k];
-    r.only(lj, at, {"apl_count", "map_resolution", "position", "flux", "parent", "maps", "error_vs_distance"});
+    r.only(lj, at, {"apl_count", "map_resolution", "map_frame", "position", "flux", "parent", "maps", "error_vs_distance"});
     BundleLevelInfo l;
     const std::size_t n = std::size_t(r.integer(r.member(lj, at, "apl_count"), at + "/apl_count", 1,
                                                 (long long)limits.max_apls_per_level, "BundleLimits::max_apls_per_level"));
     if (k > 0 && n <= m.levels.back().apl_count())
       r.fail(at + "/apl_count", "does not exceed the previous level's " + std::to_string(m.levels.back().apl_count()));
     l.map_resolution = int(r.integer(r.member(lj, at, "map_resolution"), at + "/map_resolution", 1, sphere_map::kMaxResolution));
+    if (lj.contains("map_frame")) {
+      const std::string fp = at + "/map_frame";
+      if (m.format_version < 2) r.fail(fp, "not part of format version " + std::to_string(m.format_version));
+      const json& rows = r.array(lj["map_frame"], fp, 3);
+      for (int row = 0; row < 3; ++row) {
+        const glm::dvec3 v = r.vec3(rows[std::size_t(row)], fp + "/" + std::to_string(row));
+        for (int c = 0; c < 3; ++c) l.frame.to_map[c][row] = float(v[c]);
+      }
+      const auto [off, det] = l.frame.deviation();
+      if (!(off <= 1e-4f) || !(std::abs(det - 1.0f) <= 1e-4f))
+        r.fail(fp, "not a rotation: |RᵀR − I| is " + std::to_string(off) + ", the determinant " + std::to_string(det));
+    }
     const json& pos = r.array(r.member(lj, at, "position"), at + "/position", n);
     const json& flux = r.array(r.member(lj, at, "flux"), at + "/flux", n);
     const json& parent = r.array(r.member(lj, at, "parent"), at + "/parent", n);
