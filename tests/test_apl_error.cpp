@@ -418,7 +418,7 @@ TEST(AplErrorLevels, RaysFromOnePointGiveNoiseForEveryLevel) {
   AplErrorOptions o;
   o.min_timing_seconds = 0;
   o.patch_subsamples = 1;
-  // Patches in the photometric frame: their centres are texel centres of the R 64 maps' 2×2 blocks, where
+  // Patches in the photometric frame, as the maps are: their centres are texel centres of the R 64 maps' 2×2 blocks, where
   // the lookup is the texels' mean, so the level reproduces the patch sums and only the noise is measured.
   o.rotated_patches = false;
   const AplErrorReport r = evaluate_apl_errors(set, rays, o);

@@ -5,6 +5,7 @@
 #include <lumx/apl/far_field.h>
 #include <lumx/apl/apl_set.h>
 #include <lumx/apl/evaluation.h>
+#include <lumx/io/bundle_builder.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/volume/radiance_volume.h>
@@ -468,7 +469,7 @@ TEST(Bundle, MapFramesRoundTripAndAreChecked) {
   }, "/levels/0/map_frame");
   expect([](auto& j) { j["levels"][2]["map_frame"][1] = {1, 2}; }, "/levels/2/map_frame/1");
   expect([](auto& j) { j["levels"][0]["map_frame"][0][0] = "1"; }, "/levels/0/map_frame/0/0");
-  expect([](auto& j) { j["levels"][0]["map_frame"][0][0] = 1e300; }, "/levels/0/map_frame");  // inf as float
+  expect([](auto& j) { j["levels"][0]["map_frame"][0][0] = 1e300; }, "/levels/0/map_frame/0/0");  // no float cast
   expect([](auto& j) { j["format_version"] = 1; }, "/levels/0/map_frame");  // version 1 has no frames
   // A version 1 bundle (no frames) is read with the photometric frame.
   const AplSet plain = three_level_set(16, ChannelLayout::luminance);
@@ -481,6 +482,21 @@ TEST(Bundle, MapFramesRoundTripAndAreChecked) {
   const BundleReader r1(old.string());
   EXPECT_EQ(r1.manifest().format_version, 1);
   EXPECT_TRUE(r1.load_level(2).frame.is_identity());
+}
+
+TEST(Bundle, RecordedBuildOptionsKeepTheMapFrameChoice) {
+  // lumx eval rebuilds a bundle's levels from its recorded options: a bundle from before the map frame
+  // (no "orient_maps") was drawn in the photometric frame, and is rebuilt so.
+  AplBuildOptions o;
+  for (bool orient : {true, false}) {
+    o.orient_maps = orient;
+    EXPECT_EQ(build_options_from_json(build_options_json(o)).orient_maps, orient);
+  }
+  nlohmann::json old = nlohmann::json::parse(build_options_json(AplBuildOptions{}));
+  old.erase("orient_maps");
+  EXPECT_FALSE(build_options_from_json(old.dump()).orient_maps);
+  old["orient_maps"] = "yes";
+  EXPECT_THROW(build_options_from_json(old.dump()), std::invalid_argument);
 }
 
 TEST(Bundle, VolumeManifestRulesAreEnforced) {
@@ -583,6 +599,7 @@ TEST(Bundle, WriterOutputValidatesAgainstTheJsonSchema) {
   const fs::path dir = root / "s.lumx";
   RadianceVolume volume(Aabb{glm::dvec3(-0.2, -0.2, 0.0), glm::dvec3(0.2, 0.2, 0.1)}, 512, 4, 3);
   AplSet set = three_level_set(8);
+  set.levels[2].frame = map_frame_for(glm::dvec3(0.1, 0.2, -1.0));  // a turned level: map_frame in the schema
   set.levels[1].error.relative_distance = {0.5, 1, 2};
   set.levels[1].error.relative_rmse = {0.2, 0.1, 0.05};
   BundleWriteOptions with_files;
@@ -596,12 +613,15 @@ TEST(Bundle, WriterOutputValidatesAgainstTheJsonSchema) {
   j["units"]["flux"] = "W";
   j["levels"][0]["maps"][0]["sha256"] = "XYZ";
   j["levels"][0]["surprise"] = 1;
+  ASSERT_TRUE(j["levels"][2].contains("map_frame"));
+  j["levels"][2]["map_frame"][1] = {0.5, 0.5};
   write_manifest(dir, j);
   EXPECT_NE(std::system(cmd.c_str()), 0);
   const std::string out = slurp(root / "out.txt");
   EXPECT_NE(out.find("/units"), std::string::npos) << out;
   EXPECT_NE(out.find("/levels/0/maps/0/sha256"), std::string::npos) << out;
   EXPECT_NE(out.find("surprise"), std::string::npos) << out;
+  EXPECT_NE(out.find("/levels/2/map_frame/1"), std::string::npos) << out;
 }
 
 TEST(Bundle, AttachmentsShipWithTheSet) {

@@ -250,9 +250,9 @@ class Level:
     @property
     def map_bytes(self) -> int: ...
     def map(self, apl: int) -> npt.NDArray[np.float32]:
-        """(R, 2R, channels) read-only view, cd or W/sr."""
+        """(R, 2R, channels) read-only view, cd or W/sr, drawn in map_frame."""
     def maps(self) -> npt.NDArray[np.float32]:
-        """(N, R, 2R, channels) copy, cd or W/sr."""
+        """(N, R, 2R, channels) copy, cd or W/sr, drawn in map_frame."""
     def intensity(self, directions: ArrayLike, rgb: bool = False) -> Union[float, FloatArray]:
         """Far-field intensity of the level, cd or W/sr."""
     def sample_emission(self, u: ArrayLike) -> np.ndarray:
@@ -339,8 +339,10 @@ class Bundle:
         """Level.pdf on a level (default the finest), 1/sr."""
     def load_volume(self) -> RadianceVolume: ...
 
-def direction_to_uv(directions: ArrayLike) -> FloatArray: ...
-def uv_to_direction(uv: ArrayLike) -> FloatArray: ...
+def direction_to_uv(directions: ArrayLike) -> FloatArray:
+    """(u, v) of directions in a sphere map's own frame (a level's: Level.map_frame @ w)"""
+def uv_to_direction(uv: ArrayLike) -> FloatArray:
+    """directions, in the sphere map's own frame, of (u, v) (photometric: Level.map_frame.T @ m)"""
 
 # ---- building
 

@@ -722,7 +722,8 @@ void bind_bundle(py::module_& m) {
       },
       py::arg("directions"),
       "Sphere-map coordinates (u, v) in [0, 1]^2 of directions (N, 3): u across the 2R-wide image (left "
-      "half z >= 0), v down its R rows.");
+      "half z >= 0), v down its R rows. The directions are in the maps' frame: for a level's maps pass "
+      "level.map_frame @ w of a photometric direction w (Level.map_frame).");
   m.def(
       "uv_to_direction",
       [](const py::object& uv) {
@@ -743,7 +744,8 @@ void bind_bundle(py::module_& m) {
       },
       py::arg("uv"),
       "Unit directions of sphere-map coordinates (..., 2) -> (..., 3); texel (x, y) of an R map has "
-      "its centre at ((x + 0.5) / 2R, (y + 0.5) / R).");
+      "its centre at ((x + 0.5) / 2R, (y + 0.5) / R). The directions are in the maps' frame: "
+      "level.map_frame.T @ m turns one photometric (Level.map_frame).");
 }
 
 }  // namespace lumx_py

@@ -203,7 +203,8 @@ struct AplErrorOptions {
   int patch_subsamples = 1;
   /// true (default): the patches are laid out in a frame rotated from the photometric frame (patch_frame()
   /// below), so their centres fall at generic places of the maps' texel grids. With false the patch centres
-  /// of R_patch = 16 are the texel centres of every R 16 map (and of coarser maps' texel edges and corners),
+  /// of R_patch = 16 are the texel centres of every R 16 map drawn in the photometric frame (MapFrame
+  /// identity; and of coarser maps' texel edges and corners),
   /// where a bilinear lookup returns a texel's mean exactly: the maps' interpolation error (largest along
   /// the concentric map's diagonals, where direction → square is not smooth) is then never seen, and a
   /// level at R 16 is graded ~2× better than at a renderer's random shading points (docs/apl_sets.md).
@@ -689,8 +690,8 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
 // dropped d = 0.5 from an LED strip's middle levels, 72 % off there; with that sphere gone the one-
 // standard-error rule no longer found R 32 as good as R 64 or R 64 as good as R 128, and the 10 M-ray
 // bundle grew from 13.6 to 25.6 MB and its build from 82 to 94 s, for held-out errors the rays cannot
-// tell apart.) the coarsest resolution with a candidate within one standard
-// error of it is kept (the one-standard-error rule in fit_map_resolutions). (The noise variance of the
+// tell apart.) The coarsest resolution with a candidate within one standard
+// error of the best is kept (the one-standard-error rule in fit_map_resolutions). (The noise variance of the
 // reference is the same for every candidate, so the raw ε ranks them.) The
 // choice is made on a set built from half the rays; a set from all of them has half the noise variance
 // and might afford one step finer — the choice is the conservative one.

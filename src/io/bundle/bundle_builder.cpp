@@ -85,7 +85,8 @@ std::string build_options_json(const AplBuildOptions& o) {
                             {"cluster_by", o.line_clustering == LC::start_points ? "start"
                                            : o.line_clustering == LC::lines      ? "line"
                                                                                  : "auto"},
-                            {"smooth", o.map_smoothing_rays}};
+                            {"smooth", o.map_smoothing_rays},
+                            {"orient_maps", o.orient_maps}};
   return j.dump();
 }
 
@@ -111,6 +112,10 @@ AplBuildOptions build_options_from_json(const std::string& text) {
   get("apl_exponent", o.apl_exponent);
   get("converge", o.place_at_convergence);
   get("smooth", o.map_smoothing_rays);
+  // Bundles written before the map frame recorded no "orient_maps": their maps are in the photometric
+  // frame, and a rebuild from their options must draw them so too.
+  o.orient_maps = false;
+  get("orient_maps", o.orient_maps);
   std::string by = "auto";
   get("cluster_by", by);
   using LC = AplBuildOptions::LineClustering;

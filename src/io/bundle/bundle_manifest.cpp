@@ -305,8 +305,14 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
       if (m.format_version < 2) r.fail(fp, "not part of format version " + std::to_string(m.format_version));
       const json& rows = r.array(lj["map_frame"], fp, 3);
       for (int row = 0; row < 3; ++row) {
-        const glm::dvec3 v = r.vec3(rows[std::size_t(row)], fp + "/" + std::to_string(row));
-        for (int c = 0; c < 3; ++c) l.frame.to_map[c][row] = float(v[c]);
+        const std::string rp = fp + "/" + std::to_string(row);
+        const glm::dvec3 v = r.vec3(rows[std::size_t(row)], rp);
+        for (int c = 0; c < 3; ++c) {
+          // A rotation's entries lie in [−1, 1]; checked before the cast to float, which a larger value
+          // would overflow.
+          if (!(std::abs(v[c]) <= 1.0 + 1e-3)) r.fail(rp + "/" + std::to_string(c), "outside [-1, 1]: not a rotation");
+          l.frame.to_map[c][row] = float(v[c]);
+        }
       }
       const auto [off, det] = l.frame.deviation();
       if (!(off <= 1e-4f) || !(std::abs(det - 1.0f) <= 1e-4f))
