@@ -763,64 +763,69 @@ namespace {
 // σ 3.4°: at d ≥ 5 a bias stays). Then, from the 1 M rays, the finest level at R 128 with σ = 1.5 texel
 // widths, sharpened, set by hand (the fit's choice for the cos^50 spot before the extrapolated and
 // two-scale kernels). Then the floor of maps at the spot's centre: one APL whose map is the exact
-// intensity averaged over each texel, at R 64 and 128. Printed, and checked against the documented rows.
-// Off by default (about 3 min):
-//   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*SpotStudy*'
+// intensity averaged over each texel, at R 64 and 128. The built rows twice: with the maps in the
+// photometric frame (as measured before MapFrame) and turned, as lumx build now draws a beam's maps.
+// Printed, and checked against the documented rows. Off by default (about 6 min):
+//   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*WhatMoreRaysBuy*'
 TEST(SpotStudy, DISABLED_WhatMoreRaysBuy) {
-  // cos^20 then cos^50; 1 M rays, 4 M rays, 1 M rays with R 128's kernel by hand, exact map R 64, exact
-  // map R 128; d = 1, 2, 5, 10, %.
-  const double documented[2][5][4] = {
-      {{1.19, 1.54, 2.56, 3.28}, {0.64, 0.68, 1.29, 1.52}, {3.25, 3.55, 3.44, 4.28}, {165.38, 50.51, 7.76, 4.00},
-       {167.12, 52.14, 8.47, 1.92}},
-      {{1.48, 2.47, 3.92, 4.58}, {0.88, 1.46, 3.03, 3.97}, {2.90, 3.62, 4.04, 4.40}, {425.44, 160.05, 26.62, 10.39},
-       {429.46, 163.93, 28.75, 6.68}}};
+  // [maps in the photometric frame, turned (MapFrame, as shipped)][cos^20, cos^50][1 M rays, 4 M rays,
+  // 1 M rays with R 128's kernel by hand][d = 1, 2, 5, 10], %; then the exact maps, which do not depend
+  // on the builder: [cos^20, cos^50][R 64, R 128][d].
+  const double documented[2][2][3][4] = {
+      {{{1.19, 1.54, 2.56, 3.28}, {0.64, 0.68, 1.29, 1.52}, {3.25, 3.55, 3.44, 4.28}},
+       {{1.48, 2.47, 3.92, 4.58}, {0.88, 1.46, 3.03, 3.97}, {2.90, 3.62, 4.04, 4.40}}},
+      {{{1.21, 1.53, 2.53, 3.23}, {0.63, 0.59, 1.05, 1.17}, {3.25, 3.49, 3.31, 4.41}},
+       {{1.50, 2.18, 3.34, 3.68}, {0.96, 1.38, 2.32, 2.91}, {3.02, 3.08, 3.93, 4.03}}}};
+  const double documented_exact[2][2][4] = {{{165.38, 50.51, 7.76, 4.00}, {167.12, 52.14, 8.47, 1.92}},
+                                            {{425.44, 160.05, 26.62, 10.39}, {429.46, 163.93, 28.75, 6.68}}};
   for (int which : {2, 3}) {
     const std::unique_ptr<AnalyticEmitter> em = suite_emitter(which);
-    int n_index = 0;
-    for (const std::uint64_t n : {std::uint64_t(1000000), std::uint64_t(4000000)}) {
-      auto rays = em->source(n, 11 + std::uint64_t(which));
-      AplBuildOptions bo;
-      bo.threads = 2;
-      AplErrorOptions eo;
-      ResolutionChoice choice;
-      const AplSet set = shipped_set(*rays, choice, false);  // as documented: before MapFrame
-      const MeasurementSpheres ms(set.bounds, eo);
-      const ExactOnSpheres exact = exact_on_spheres(*em, ms, 1);
-      const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);
-      const std::size_t k = set.levels.size() - 1;
-      std::printf("%s, %llu rays, %zu APLs R %d σ %.1f° %s:", em->name().c_str(), (unsigned long long)n,
-                  set.levels[k].size(), set.levels[k].map_resolution,
-                  choice.kappa.at(k) > 0 ? 180.0 / kPi / std::sqrt(choice.kappa.at(k)) : 0.0,
-                  kernel_mode_name(choice.mode.at(k)));
-      int col = 0;
-      for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
-        if (ms.relative_distances()[s] < 1) continue;
-        const std::vector<double> model = level_at_points(set, k, ms, s, dirs);
-        const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
-        std::printf(" %6.2f", e);
-        const double doc = documented[which - 2][n_index][col++];
-        if (doc > 0) {
-          EXPECT_NEAR(e, doc, 0.01) << n << " rays, sphere " << s;
-        }
-      }
-      std::printf("\n");
-      if (n == 1000000) {
-        AplSet by_hand = build_apl_set(*rays, bo);
-        const int R = 128;
-        const double texel = std::sqrt(4.0 * kPi / (2.0 * R * R));
-        by_hand.levels[k] = fitted_level(by_hand.levels[k], R, 1.0 / ((1.5 * texel) * (1.5 * texel)), KernelMode::sharpened);
-        std::printf("%s, %llu rays, %zu APLs R %d σ %.1f° sharpened, by hand:", em->name().c_str(), (unsigned long long)n,
-                    by_hand.levels[k].size(), R, 1.5 * texel * 180.0 / kPi);
-        col = 0;
+    for (const bool turned : {false, true}) {
+      int n_index = 0;
+      for (const std::uint64_t n : {std::uint64_t(1000000), std::uint64_t(4000000)}) {
+        auto rays = em->source(n, 11 + std::uint64_t(which));
+        AplBuildOptions bo;
+        bo.threads = 2;
+        bo.orient_maps = turned;
+        AplErrorOptions eo;
+        ResolutionChoice choice;
+        const AplSet set = shipped_set(*rays, choice, turned);
+        const MeasurementSpheres ms(set.bounds, eo);
+        const ExactOnSpheres exact = exact_on_spheres(*em, ms, 1);
+        const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);
+        const std::size_t k = set.levels.size() - 1;
+        const char* frame = turned ? "turned" : "photometric";
+        std::printf("%s, %s frame, %llu rays, %zu APLs R %d σ %.1f° %s:", em->name().c_str(), frame,
+                    (unsigned long long)n, set.levels[k].size(), set.levels[k].map_resolution,
+                    choice.kappa.at(k) > 0 ? 180.0 / kPi / std::sqrt(choice.kappa.at(k)) : 0.0,
+                    kernel_mode_name(choice.mode.at(k)));
+        int col = 0;
         for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
           if (ms.relative_distances()[s] < 1) continue;
-          const double e = 100 * compare_irradiance(exact.at_centre[s], level_at_points(by_hand, k, ms, s, dirs)).relative_rmse;
+          const std::vector<double> model = level_at_points(set, k, ms, s, dirs);
+          const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
           std::printf(" %6.2f", e);
-          EXPECT_NEAR(e, documented[which - 2][2][col++], 0.01) << "R 128 by hand, sphere " << s;
+          EXPECT_NEAR(e, documented[turned][which - 2][n_index][col++], 0.01) << frame << ", " << n << " rays, sphere " << s;
         }
         std::printf("\n");
+        if (n == 1000000) {
+          AplSet by_hand = build_apl_set(*rays, bo);
+          const int R = 128;
+          const double texel = std::sqrt(4.0 * kPi / (2.0 * R * R));
+          by_hand.levels[k] = fitted_level(by_hand.levels[k], R, 1.0 / ((1.5 * texel) * (1.5 * texel)), KernelMode::sharpened);
+          std::printf("%s, %s frame, %llu rays, %zu APLs R %d σ %.1f° sharpened, by hand:", em->name().c_str(), frame,
+                      (unsigned long long)n, by_hand.levels[k].size(), R, 1.5 * texel * 180.0 / kPi);
+          col = 0;
+          for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
+            if (ms.relative_distances()[s] < 1) continue;
+            const double e = 100 * compare_irradiance(exact.at_centre[s], level_at_points(by_hand, k, ms, s, dirs)).relative_rmse;
+            std::printf(" %6.2f", e);
+            EXPECT_NEAR(e, documented[turned][which - 2][2][col++], 0.01) << frame << ", R 128 by hand, sphere " << s;
+          }
+          std::printf("\n");
+        }
+        ++n_index;
       }
-      ++n_index;
     }
     // The floor of maps: one APL at the spot's centre, its map the exact intensity averaged over each texel
     // (I(ω) = r² E(r ω) at r = 10⁴ m, 4 × 4 sub-directions), read bilinearly.
@@ -859,7 +864,7 @@ TEST(SpotStudy, DISABLED_WhatMoreRaysBuy) {
         const std::vector<double> model = level_at_points(set, 0, ms, s, dirs);
         const double e = 100 * compare_irradiance(exact.at_centre[s], model).relative_rmse;
         std::printf(" %6.2f", e);
-        EXPECT_NEAR(e, documented[which - 2][R == 64 ? 3 : 4][col++], 0.01) << "exact map, R " << R << ", sphere " << s;
+        EXPECT_NEAR(e, documented_exact[which - 2][R == 64 ? 0 : 1][col++], 0.01) << "exact map, R " << R << ", sphere " << s;
       }
       std::printf("\n");
     }
