@@ -279,14 +279,20 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // The fit widens two-scale only while widening helped (fit_map_resolutions): at each level and
   // resolution, a two-scale candidate is followed by a wider one only if it graded better than the one
   // before it (on the box, σ 6.7° grades worse than 3.4°, and 10.1° is not tried).
-  for (std::size_t k = 0; k < choice.tried.size(); ++k) {
-    std::map<int, std::vector<double>> two_scale;  // per resolution, the costs in the order tried
-    for (const FitCandidate& c : choice.tried[k])
-      if (c.mode == KernelMode::two_scale) two_scale[c.resolution].push_back(c.cost);
-    for (const auto& [R, costs] : two_scale)
-      for (std::size_t i = 1; i + 1 < costs.size(); ++i)
-        EXPECT_LT(costs[i], costs[i - 1]) << "level " << k << ", R " << R << ": widened after a worse width";
-  }
+  // So does spectral, and on a one-APL level it tries one width.
+  for (std::size_t k = 0; k < choice.tried.size(); ++k)
+    for (const KernelMode mode : {KernelMode::two_scale, KernelMode::spectral}) {
+      std::map<int, std::vector<double>> widths;  // per resolution, the costs in the order tried
+      for (const FitCandidate& c : choice.tried[k])
+        if (c.mode == mode) widths[c.resolution].push_back(c.cost);
+      for (const auto& [R, costs] : widths) {
+        for (std::size_t i = 1; i + 1 < costs.size(); ++i)
+          EXPECT_LT(costs[i], costs[i - 1]) << "level " << k << ", R " << R << ": widened after a worse width";
+        if (set.levels[k].size() <= 1) {
+          EXPECT_LE(costs.size(), mode == KernelMode::spectral ? 1u : 0u) << "level " << k;
+        }
+      }
+    }
   const MeasurementSpheres ms(set.bounds, eo);
   const ExactOnSpheres exact = exact_on_spheres(*em, ms, 1);
   const std::vector<glm::dvec3> dirs = ms.evaluation_directions(1);
@@ -385,14 +391,15 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // The finest level at d ≥ 1, as the fitted maps reach it (docs/apl_sets.md): the disk 0.90-1.00 % and
   // the rectangle 1.02-1.08 % (local linear kernels; 1.80-1.87 % when the fit graded against patch means
   // rather than centred references, FitReference above; the target is 2 %), the cos^20 spot
-  // 1.19-3.28 % (R 128, σ 5.0° two-scale; 1.87-2.90 % extrapolated at σ 3.4°, 1.87-3.17 % sharpened,
-  // 1.93-4.32 % when the kernels stopped at R 64), the cos^50 spot 1.48-4.58 % (R 128, σ 3.4° two-scale;
-  // 2.90-4.40 % sharpened at σ 1.7°, 3.0-11.3 % with R 64 chosen against patch means:
-  // SpotStudy.DISABLED_WhatMoreRaysBuy).
+  // 1.22-2.09 % (R 128, σ 5.0° spectral; 1.21-3.23 % two-scale, 1.87-2.90 % extrapolated at σ 3.4°,
+  // 1.87-3.17 % sharpened, 1.93-4.32 % when the kernels stopped at R 64), the cos^50 spot 1.14-2.87 %
+  // (R 128, σ 5.0° spectral; 1.50-3.68 % two-scale at σ 3.4°, 2.90-4.40 % sharpened at σ 1.7°, 3.0-11.3 %
+  // with R 64 chosen against patch means: SpotStudy.DISABLED_WhatMoreRaysBuy). Guards: a point over the
+  // spots' worst, whose noise between seeds is 0.5-1 point at d = 10 (SpotBiasAndNoise).
   // The box with holes: 37.0-41.3 % (49.3-53.1 % when the half set's maps were one step coarser than the
   // shipped set's, so the fit could not choose the resolution the shipped set is built at); exact maps at
   // R 64 are 33-36 % off there (PinholeBoxStudy.DISABLED_ExactBeamsAtTheSourcesBoundWhatMapsCanDo).
-  const double guard[] = {0.0125, 0.0125, 0.04, 0.05, 0.45};
+  const double guard[] = {0.0125, 0.0125, 0.03, 0.04, 0.45};
   for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
     const double d = ms.relative_distances()[s];
     if (d >= 1) {

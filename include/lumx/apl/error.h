@@ -819,7 +819,10 @@ struct FitKernel {
 /// built resolution only, and widens it only while that helps) at σ = 1.5, 3 and 4.5 texel widths (4.5: a
 /// cos^20 spot's maps from 1 M rays, about 2 000 rays each, want σ 5° while its sum affords 2.5°; over
 /// four seeds its finest level is 1.62–3.18 % at d ≥ 1 with that candidate and 1.87–3.21 % without,
-/// apl_sets.md). R 128's kernels are for
+/// apl_sets.md); and spectral (SphereMapKernel::spectral_gain: as two-scale, the level's shape from its
+/// sum's harmonic expansion shrunk degree by degree, which no kernel's width can match on a narrow lobe: a
+/// cos^20 spot's finest level 2.53/3.23 → 1.98/2.09 % at d = 5/10) at the same widths and on the same terms,
+/// one width on a one-APL level. R 128's kernels are for
 /// narrow lobes: a spot read through R 64 texels keeps their blur (a cos^20 spot's far field 4 % off,
 /// noise-free), and R 128 with a kernel as wide as R 64's averages the same noise through finer texels
 /// (apl_sets.md).
@@ -833,6 +836,7 @@ inline std::vector<FitKernel> fit_kernels(int R) {
   for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::local_linear});
   for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::extrapolated});
   for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::two_scale});
+  for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::spectral});
   return out;
 }
 
@@ -978,8 +982,8 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       admit(SphereMap());
       // The cost of the last two-scale candidate admitted at this R, and whether a wider one may still win.
-      double two_scale_before = INFINITY;
-      bool two_scale_improving = true;
+      double two_scale_before = INFINITY, spectral_before = INFINITY;
+      bool two_scale_improving = true, spectral_improving = true;
       for (const FitKernel& kernel : set_rays > 0 && !at_r.apls.empty() ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
         // Two-scale keeps the level's sum sharp at a distance, so only where the maps are fine enough to
@@ -996,6 +1000,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         // than 3.4° at every level, so 10.1° is not tried).
         if (kernel.mode == KernelMode::two_scale && !two_scale_improving) continue;
         if (kernel.mode == KernelMode::two_scale) two_scale_improving = false;  // until admitted and better
+        // Spectral likewise: at the built resolution (its expansion costs a second per level sum at R 128),
+        // widened while that helps; on one map the width only sets the estimate's reach, so one width.
+        if (kernel.mode == KernelMode::spectral && (R != built.map_resolution || !spectral_improving)) continue;
+        if (kernel.mode == KernelMode::spectral) spectral_improving = false;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where a
         // patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7° lowered the
         // peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10). Kept with the
@@ -1024,6 +1032,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         if (kernel.mode == KernelMode::two_scale) {
           two_scale_improving = tried.back().cost < two_scale_before;
           two_scale_before = tried.back().cost;
+        }
+        if (kernel.mode == KernelMode::spectral) {
+          spectral_improving = built.size() > 1 && tried.back().cost < spectral_before;
+          spectral_before = tried.back().cost;
         }
         admit(gain);
       }
