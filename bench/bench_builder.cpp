@@ -11,6 +11,8 @@
 //                    peak_rss_MiB is the process's high-water mark (the 10 M rays themselves are 280 MB).
 //   read_tm25/N      stream an N-ray TM-25 file (written first) from the page cache: throughput, memory
 //   build_file/N/T   what `lumx build FILE OUT --threads T` does on an N-ray TM-25 file, by phase
+//   harmonic_estimate/R/T   the spectral pilot of one level sum (math/sphere_map_harmonics.h): expansion to
+//                    degree min(R, 96), shrinkage, synthesis, on a map of 10⁶ rays of a cos^20 lobe, T threads
 // Rays: 64 emitters on a 0.3 m ring, 1 mm discs, cos³ lobes tilted outwards, in memory (SoA floats).
 #include <lumx/apl/builder.h>
 #include <lumx/apl/error.h>
@@ -19,6 +21,7 @@
 #include <lumx/io/bundle_builder.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/rayset_io.h>
+#include <lumx/math/sphere_map_harmonics.h>
 
 #include <unistd.h>
 
@@ -184,5 +187,22 @@ void build_file(benchmark::State& state) {
 BENCHMARK(build_file)->Args({1000000, 2})->Args({10000000, 2})->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace
+
+namespace {
+void harmonic_estimate_bench(benchmark::State& state) {
+  const int R = int(state.range(0));
+  SphereMap map(R, 1);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 1000000; ++i) {
+    const double ct = std::pow(u(rng), 1.0 / 21.0), st = std::sqrt(1 - ct * ct), phi = 2 * kPi * u(rng);
+    int x, y;
+    map.texel_of(glm::vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(-ct)), x, y);
+    map.at(x, y, 0) += 1.0f;
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(harmonic_estimate(map, unsigned(state.range(1))).estimate.data());
+}
+}  // namespace
+BENCHMARK(harmonic_estimate_bench)->Name("harmonic_estimate")->ArgsProduct({{32, 64, 128}, {1, 2}})->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

@@ -778,16 +778,18 @@ inline AplLevel smoothed_level_with_gain(const AplLevel& level, const SphereMapK
 /// (its far field) for every map (SphereMapKernel::apply_with_gain), so the sparse maps sum to the sum's
 /// estimate.
 inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& kernel, unsigned threads = 0,
-                               KernelMode mode = KernelMode::plain) {
+                               KernelMode mode = KernelMode::plain, HarmonicEstimateCache* cache = nullptr) {
   const SphereMap gain =
-      mode != KernelMode::plain && !level.apls.empty() ? kernel.gain(level_sum(level), mode) : SphereMap();
+      mode != KernelMode::plain && !level.apls.empty() ? kernel.gain(level_sum(level), mode, cache) : SphereMap();
   return smoothed_level_with_gain(level, kernel, mode, gain, threads);
 }
 
 /// The fitted maps of a level: downsampled to R, then smoothed by the kernel of κ in `mode` when κ > 0.
-inline AplLevel fitted_level(const AplLevel& level, int R, double kappa, KernelMode mode = KernelMode::plain) {
+/// `cache`: where a spectral kernel's expansions are kept for the next level (one per set).
+inline AplLevel fitted_level(const AplLevel& level, int R, double kappa, KernelMode mode = KernelMode::plain,
+                             HarmonicEstimateCache* cache = nullptr) {
   AplLevel out = downsampled_level(level, R);
-  if (kappa > 0) out = smoothed_level(out, *SphereMapKernel::shared(R, kappa), 0, mode);
+  if (kappa > 0) out = smoothed_level(out, *SphereMapKernel::shared(R, kappa), 0, mode, cache);
   return out;
 }
 
@@ -939,6 +941,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
   AplErrorOptions o = options;
   o.min_timing_seconds = 0;
   const auto kernel_for = [](int R, double kappa) { return SphereMapKernel::shared(R, kappa); };
+  HarmonicEstimateCache spectra;  // every level's sum is the same rays': one expansion for all
   for (std::size_t k = 0; k < set.levels.size(); ++k) {
     const AplLevel built = set.levels[k];
     std::vector<FitCandidate> tried;
@@ -1012,7 +1015,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         const std::shared_ptr<const SphereMapKernel> held = kernel_for(R, kappa);
         const SphereMapKernel& kern = *held;
         const bool plain_mode = kernel.mode == KernelMode::plain;
-        const SphereMap gain = plain_mode ? SphereMap() : kern.gain(sum_at_r, kernel.mode);
+        const SphereMap gain = plain_mode ? SphereMap() : kern.gain(sum_at_r, kernel.mode, &spectra);
         const auto [lowering, allowance] = kernel_peak_change(
             sum_at_r, plain_mode ? kern.apply(sum_at_r) : kern.apply_with_gain(sum_at_r, gain), set_rays);
         if (lowering > allowance) continue;
@@ -1362,12 +1365,13 @@ inline bool apply_held_out_fit(AplSet& set, const AplErrorReport& report, const 
   bool same = report.levels.size() == set.levels.size();
   for (std::size_t k = 0; same && k < set.levels.size(); ++k) same = report.levels[k].apls == set.levels[k].size();
   if (!same) return false;
+  HarmonicEstimateCache spectra;
   if (choice)
     for (std::size_t k = 0; k < set.levels.size() && k < choice->resolution.size(); ++k)
       if (choice->resolution[k] <= set.levels[k].map_resolution)
         set.levels[k] = fitted_level(set.levels[k], choice->resolution[k],
                                      k < choice->kappa.size() ? choice->kappa[k] : 0.0,
-                                     k < choice->mode.size() ? choice->mode[k] : KernelMode::plain);
+                                     k < choice->mode.size() ? choice->mode[k] : KernelMode::plain, &spectra);
   store_error_tables(set, report);
   return true;
 }

@@ -40,7 +40,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -61,12 +60,17 @@ class SphereMapHarmonics {
     if (degree < 0 || degree > kMaxDegree)
       throw std::invalid_argument("SphereMapHarmonics: degree " + std::to_string(degree) + " outside [0, " +
                                   std::to_string(kMaxDegree) + "]");
+    // Texel centres of the upper square; texel (x + R, y) of the lower square is the mirror image of
+    // (x, y) in the equator plane (sphere_map.h), which analyse and synthesise use.
     const int W = 2 * resolution;
     centres_.resize(std::size_t(W) * std::size_t(resolution));
     for (int y = 0; y < resolution; ++y)
-      for (int x = 0; x < W; ++x)
+      for (int x = 0; x < resolution; ++x)
         centres_[std::size_t(y) * std::size_t(W) + std::size_t(x)] = glm::normalize(glm::dvec3(
             sphere_map::uv_to_direction({(float(x) + 0.5f) / float(W), (float(y) + 0.5f) / float(resolution)})));
+    odd_.assign(coefficient_count(), 0);
+    for (int l = 0; l <= degree; ++l)
+      for (int m = -l; m <= l; ++m) odd_[std::size_t(l * (l + 1) + m)] = char((l + std::abs(m)) % 2);
     // P̄_mm without its sin^m θ (a constant) and the recurrence constants A_lm, B_lm.
     const int n = degree + 1;
     diagonal_.assign(std::size_t(n), 0.0);
@@ -88,21 +92,27 @@ class SphereMapHarmonics {
 
   /// The coefficients of the density whose flux per texel is `map`'s (one channel: channel 0 is read),
   /// ĉ_lm = Σ_t F_t Y_lm(ω_t). Summed in fixed chunks of texels, each in increasing order, and the chunks in
-  /// order, so the result does not depend on `threads` (0: the hardware's).
+  /// order, so the result does not depend on `threads` (0: the hardware's). Each texel of the upper square
+  /// is taken with its mirror in the lower one: Y_lm is even or odd in z as l + m is, so one evaluation of
+  /// the basis serves both.
   std::vector<double> analyse(const SphereMap& map, unsigned threads = 0) const {
     check(map);
-    const std::size_t T = centres_.size(), chunks = 32, nc = coefficient_count();
+    const std::size_t chunks = 32, nc = coefficient_count(), R = std::size_t(resolution_), W = 2 * R;
+    const std::size_t pairs = R * R;  // texel (x, y) of the upper square and its mirror (x + R, y)
     const int C = map.channels();
     std::vector<std::vector<double>> part(chunks);
     parallel(chunks, threads, [&](std::size_t chunk) {
       std::vector<double>& c = part[chunk];
       c.assign(nc, 0.0);
       std::vector<double> y(nc);
-      for (std::size_t t = T * chunk / chunks; t < T * (chunk + 1) / chunks; ++t) {
-        const double f = double(map.data()[t * std::size_t(C)]);
-        if (f == 0.0) continue;
-        basis(centres_[t], y.data());
-        for (std::size_t i = 0; i < nc; ++i) c[i] += f * y[i];
+      for (std::size_t i = pairs * chunk / chunks; i < pairs * (chunk + 1) / chunks; ++i) {
+        const std::size_t up = (i / R) * W + i % R, down = up + R;
+        const double fu = double(map.data()[up * std::size_t(C)]), fd = double(map.data()[down * std::size_t(C)]);
+        if (fu == 0.0 && fd == 0.0) continue;
+        basis(centres_[up], y.data());
+        // Y_lm(x, y, −z) = (−1)^(l+m) Y_lm(x, y, z): one basis for both texels.
+        const double even = fu + fd, odd = fu - fd;
+        for (std::size_t k = 0; k < nc; ++k) c[k] += (odd_[k] ? odd : even) * y[k];
       }
     });
     std::vector<double> out(nc, 0.0);
@@ -120,14 +130,17 @@ class SphereMapHarmonics {
                                   std::to_string(degree_));
     SphereMap out(resolution_, 1);
     const double omega = out.texel_solid_angle();
-    const std::size_t T = centres_.size(), chunks = 32, nc = coefficient_count();
+    const std::size_t chunks = 32, nc = coefficient_count(), R = std::size_t(resolution_), W = 2 * R;
+    const std::size_t pairs = R * R;
     parallel(chunks, threads, [&](std::size_t chunk) {
       std::vector<double> y(nc);
-      for (std::size_t t = T * chunk / chunks; t < T * (chunk + 1) / chunks; ++t) {
-        basis(centres_[t], y.data());
-        double v = 0;
-        for (std::size_t i = 0; i < nc; ++i) v += c[i] * y[i];
-        out.data()[t] = float(v * omega);
+      for (std::size_t i = pairs * chunk / chunks; i < pairs * (chunk + 1) / chunks; ++i) {
+        const std::size_t up = (i / R) * W + i % R, down = up + R;
+        basis(centres_[up], y.data());
+        double even = 0, odd = 0;
+        for (std::size_t k = 0; k < nc; ++k) (odd_[k] ? odd : even) += c[k] * y[k];
+        out.data()[up] = float((even + odd) * omega);
+        out.data()[down] = float((even - odd) * omega);
       }
     });
     return out;
@@ -170,8 +183,9 @@ class SphereMapHarmonics {
  private:
   static constexpr double kSqrt2 = 1.4142135623730951;
   int resolution_ = 0, degree_ = 0;
-  std::vector<glm::dvec3> centres_;
+  std::vector<glm::dvec3> centres_;  ///< upper square's texel centres (the lower square's are their mirrors)
   std::vector<double> diagonal_, a_, b_;
+  std::vector<char> odd_;  ///< per coefficient: whether l + |m| is odd (Y_lm is odd in z)
 
   std::size_t at(int l, int m) const { return std::size_t(l) * std::size_t(degree_ + 1) + std::size_t(m); }
 
@@ -265,29 +279,30 @@ inline HarmonicEstimate harmonic_estimate(const SphereMap& map, unsigned threads
   return out;
 }
 
-/// harmonic_estimate(map).estimate from a small process-wide cache (the last 4 maps, compared value for
-/// value; thread-safe): every level of a set sums the same rays, and the held-out fit asks for the same
-/// level sum's estimate for each width it tries.
-inline SphereMap shared_harmonic_estimate(const SphereMap& map) {
-  struct Entry {
-    SphereMap in, out;
-  };
-  static std::mutex mutex;
-  static std::vector<Entry> cache;
-  const auto same = [&](const SphereMap& a) {
-    return a.resolution() == map.resolution() && a.channels() == map.channels() &&
-           std::equal(a.values().begin(), a.values().end(), map.values().begin());
-  };
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    for (const Entry& e : cache)
-      if (same(e.in)) return e.out;
+/// Harmonic estimates of the maps asked for, one computed per map unless a map within 10⁻⁵ of the largest
+/// texel of one asked for before comes again: the levels of a set sum the same rays in different orders,
+/// so their sums differ by float rounding only, and the held-out fit asks for each level's sum at every
+/// width it tries. One cache per fit (not process-wide), so a result never depends on what an earlier
+/// build asked for.
+class HarmonicEstimateCache {
+ public:
+  /// harmonic_estimate(map, threads).estimate, or the one of a map found equal as above.
+  const SphereMap& estimate(const SphereMap& map, unsigned threads = 0) {
+    float peak = 0;
+    for (float v : map.values()) peak = std::max(peak, std::abs(v));
+    for (const auto& [in, out] : entries_) {
+      if (in.resolution() != map.resolution() || in.channels() != map.channels()) continue;
+      bool same = true;
+      for (std::size_t i = 0; same && i < in.values().size(); ++i)
+        same = std::abs(in.values()[i] - map.values()[i]) <= 1e-5f * peak;
+      if (same) return out;
+    }
+    entries_.emplace_back(map, harmonic_estimate(map, threads).estimate);
+    return entries_.back().second;
   }
-  SphereMap out = harmonic_estimate(map).estimate;
-  std::lock_guard<std::mutex> lock(mutex);
-  if (cache.size() >= 4) cache.erase(cache.begin());
-  cache.push_back({map, out});
-  return out;
-}
+
+ private:
+  std::vector<std::pair<SphereMap, SphereMap>> entries_;
+};
 
 LUMX_NAMESPACE_END

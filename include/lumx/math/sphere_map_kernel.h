@@ -303,34 +303,38 @@ class SphereMapKernel {
   SphereMap two_scale_gain(const SphereMap& total) const {
     SphereMap sum(resolution_, 1);
     accumulate_channels(sum, total);
-    const SphereMap wide = apply(sum);
-    const SphereMap narrow = shared(resolution_, 4.0 * kappa_)->apply_sharpened(sum);
-    SphereMap gain(resolution_, 1);
-    for (std::size_t t = 0; t < gain.texel_count(); ++t) {
-      const double g = double(wide.data()[t]);
-      gain.data()[t] = g > 0 ? float(double(narrow.data()[t]) / g) : 0.0f;
-    }
-    return gain;
+    return pilot_gain(sum, shared(resolution_, 4.0 * kappa_)->apply_sharpened(sum));
   }
 
-  /// The gain that gives maps summing to `total` the shape of shared_harmonic_estimate(total): the sum's
-  /// harmonic expansion with each degree shrunk against the rays' noise (sphere_map_harmonics.h), while each
-  /// map is smoothed at this kernel's width. As two_scale_gain, with the sum's estimate no longer a kernel's:
-  /// a kernel, sharpened or not, leaves a floor of bias and noise on a narrow lobe that the shrunk expansion
-  /// does not (a cos^20 lobe from 10⁶ rays: 3.00 % at the best sharpened width against 1.63 % for the
-  /// oracle-weighted expansion; apl_sets.md). For one map (a one-APL level) the result is that estimate,
-  /// inside this kernel's reach of the rays. 0 where K·total is 0.
-  SphereMap spectral_gain(const SphereMap& total) const {
+  /// The gain that gives maps summing to `total` the shape `shape` (one channel, this resolution) while
+  /// each is smoothed by this kernel: shape / K·total per texel, 0 where K·total is 0 (two_scale_gain,
+  /// spectral_gain).
+  SphereMap pilot_gain(const SphereMap& total, const SphereMap& shape) const {
+    if (shape.resolution() != resolution_ || shape.channels() != 1)
+      throw std::invalid_argument("SphereMapKernel: the shape must be one channel at the kernel's resolution");
     SphereMap sum(resolution_, 1);
     accumulate_channels(sum, total);
     const SphereMap wide = apply(sum);
-    const SphereMap shape = shared_harmonic_estimate(sum);
     SphereMap gain(resolution_, 1);
     for (std::size_t t = 0; t < gain.texel_count(); ++t) {
       const double g = double(wide.data()[t]);
       gain.data()[t] = g > 0 ? float(double(shape.data()[t]) / g) : 0.0f;
     }
     return gain;
+  }
+
+  /// The gain that gives maps summing to `total` the shape of harmonic_estimate(total): the sum's harmonic
+  /// expansion with each degree shrunk against the rays' noise (sphere_map_harmonics.h), while each map is
+  /// smoothed at this kernel's width. As two_scale_gain, with the sum's estimate no longer a kernel's: a
+  /// kernel, sharpened or not, leaves a floor of bias and noise on a narrow lobe that the shrunk expansion
+  /// does not (a cos^20 lobe from 10⁶ rays: 3.00 % at the best sharpened width against 1.63 % for the
+  /// oracle-weighted expansion; apl_sets.md). For one map (a one-APL level) the result is that estimate,
+  /// inside this kernel's reach of the rays. 0 where K·total is 0. `cache`, when given, keeps the
+  /// expansion for the next call with the same sum.
+  SphereMap spectral_gain(const SphereMap& total, HarmonicEstimateCache* cache = nullptr) const {
+    SphereMap sum(resolution_, 1);
+    accumulate_channels(sum, total);
+    return pilot_gain(sum, cache ? cache->estimate(sum) : harmonic_estimate(sum).estimate);
   }
 
   /// apply(in) multiplied texel by texel by `gain` (one channel, this resolution), each channel then
@@ -421,13 +425,13 @@ class SphereMapKernel {
   }
 
   /// The gain of `mode` for maps that sum to `total` (sharpening_gain, local_linear_gain, extrapolated_gain
-  /// two_scale_gain or spectral_gain; all ones for plain).
-  SphereMap gain(const SphereMap& total, KernelMode mode) const {
+  /// two_scale_gain or spectral_gain, with `cache` if given; all ones for plain).
+  SphereMap gain(const SphereMap& total, KernelMode mode, HarmonicEstimateCache* cache = nullptr) const {
     if (mode == KernelMode::sharpened) return sharpening_gain(total);
     if (mode == KernelMode::local_linear) return local_linear_gain(total);
     if (mode == KernelMode::extrapolated) return extrapolated_gain(total);
     if (mode == KernelMode::two_scale) return two_scale_gain(total);
-    if (mode == KernelMode::spectral) return spectral_gain(total);
+    if (mode == KernelMode::spectral) return spectral_gain(total, cache);
     SphereMap ones(resolution_, 1);
     std::fill(ones.values().begin(), ones.values().end(), 1.0f);
     return ones;
