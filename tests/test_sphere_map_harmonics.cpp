@@ -90,8 +90,8 @@ TEST(SphereMapHarmonics, AnalysisDoesNotDependOnTheThreadCount) {
 TEST(SphereMapHarmonics, ShrunkEstimateOfALobeBeatsEveryKernelAndKeepsFlux) {
   // A cos^20 lobe 45° from the pole, 10⁶ rays of equal flux binned at R 128, read bilinearly at random
   // directions against the exact density. The noise per coefficient is Σ Φ²/4π = 1/(4π·10⁶), estimated
-  // from the top quarter of the degrees (24 degrees, ~4 000 coefficients: a relative standard error of
-  // √(2/4000) = 2.2 %). The oracle Wiener filter's error for this lobe and ray count is 1.63 %
+  // from the top quarter of the degrees (25 degrees, 4 225 coefficients: a relative standard error of
+  // √(2/4225) = 2.2 %). The oracle Wiener filter's error for this lobe and ray count is 1.63 %
   // (docs/apl_sets.md, "Spectral pilot"); the empirical weights, read back through texels, were 2.10 %
   // (with the oracle's weights 2.05 %: estimating them costs little; the exact texel means through the
   // same weights 0.85 %, read bilinearly as they are 0.85 %, and the oracle assumes no texels): within
@@ -185,4 +185,34 @@ TEST(SphereMapHarmonics, WienerBoundsWhatAnyKernelCanDoOnALobe) {
       EXPECT_NEAR(best[2], row.extrapolated, 0.01);
     }
   }
+}
+
+TEST(SphereMapHarmonics, CacheReusesAnEstimateOnlyForTheSameMapUpToRounding) {
+  // The levels of a set sum the same rays in different orders: a map within 10⁻⁵ of the peak of one seen
+  // before gets that one's estimate; a map that differs by more gets its own; so does another resolution.
+  const SphereMap map = lobe_rays(32, 20, {0, 0, -1}, 50000, 7);
+  HarmonicEstimateCache cache;
+  const SphereMap first = cache.estimate(map, 2);
+  EXPECT_EQ(first.values(), harmonic_estimate(map, 2).estimate.values());
+  SphereMap rounded = map, moved = map;
+  float peak = 0;
+  std::size_t at = 0;
+  for (std::size_t t = 0; t < map.texel_count(); ++t)
+    if (map.data()[t] > peak) peak = map.data()[t], at = t;
+  rounded.data()[at] += 1e-6f * peak;
+  moved.data()[at] += 1e-3f * peak;
+  const SphereMap& again = cache.estimate(rounded, 2);
+  EXPECT_EQ(again.values(), first.values());
+  const SphereMap other = cache.estimate(moved, 2);
+  EXPECT_NE(other.values(), first.values());
+  EXPECT_EQ(other.values(), harmonic_estimate(moved, 2).estimate.values());
+  EXPECT_EQ(cache.estimate(lobe_rays(16, 20, {0, 0, -1}, 50000, 7), 2).resolution(), 16);
+  // Bad arguments are refused, not read out of bounds.
+  EXPECT_THROW(SphereMapHarmonics(0, 4), std::invalid_argument);
+  EXPECT_THROW(SphereMapHarmonics(8, SphereMapHarmonics::kMaxDegree + 1), std::invalid_argument);
+  const SphereMapHarmonics h(16, 4);
+  EXPECT_THROW(h.analyse(map), std::invalid_argument);
+  EXPECT_THROW(h.synthesise(std::vector<double>(3)), std::invalid_argument);
+  const SphereMapKernel k(16, 100.0);
+  EXPECT_THROW(k.spectral_gain(map), std::invalid_argument);
 }

@@ -548,7 +548,8 @@ TEST(SphereMapKernel, SpectralMapsSumToTheShrunkExpansionAndKeepEveryFlux) {
   // share 200 000 rays of one cos^20 lobe at R 64, each map smoothed at σ = 3 texel widths. The maps sum
   // to harmonic_estimate(total) (up to each map's flux rescaling), each keeps its flux, the sum is nearer
   // the exact lobe than two-scale's (the shrunk expansion against the sum sharpened at 1.5 texel widths),
-  // and directions beyond the kernel's reach of every ray stay exactly dark. One thread or two: the same maps.
+  // and directions beyond the kernel's reach of every ray stay exactly dark. Smoothed on one thread or two:
+  // the same maps (the expansion's own thread independence: SphereMapHarmonics).
   const int R = 64;
   const double texel = std::sqrt(4.0 * kPi / (2.0 * R * R));
   const SphereMapKernel wide(R, 1.0 / ((3 * texel) * (3 * texel)));

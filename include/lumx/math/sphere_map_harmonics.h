@@ -14,8 +14,8 @@
 // N_l the signal's and the noise's power in degree l (Wiener); its error is the least of every zonal
 // (rotation-invariant) linear estimate, kernels of any shape and width included. Neither S_l nor N_l is
 // known, so both are estimated from the map: N_l from the highest degrees, where a smooth lobe has no
-// power left, and S_l + N_l as the observed power P̂_l, so w_l = max(0, 1 − N̂_l / P̂_l) (the positive-part
-// James–Stein rule per degree; Efron & Morris 1973). For a cos^20 lobe from 10⁶ rays the oracle Wiener
+// power left, and S_l + N_l as the observed power P̂_l, so w_l = max(0, 1 − N̂_l / P̂_l) (a plug-in Wiener
+// rule per degree, close to positive-part James–Stein, which uses 2l − 1 for 2l + 1: Efron & Morris 1973). For a cos^20 lobe from 10⁶ rays the oracle Wiener
 // error is 1.63 % (relative RMSE over the sphere) where the best sharpened Gaussian kernel's is 3.00 % and
 // the best extrapolated one's 2.42 % (docs/apl_sets.md, "Spectral pilot").
 //
@@ -40,6 +40,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <deque>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -213,7 +214,9 @@ class SphereMapHarmonics {
 };
 
 /// What harmonic_estimate found: the estimate, the degree it expanded to, the noise power per
-/// coefficient it estimated (V/4π), and the weight it gave each degree (after the read-blur correction).
+/// coefficient it used (the top degrees' mean power: V/4π plus what texel sampling aliases there, +18 %
+/// for a cos^20 lobe from 10⁶ rays at R 128; or the caller's), and the weight it gave each degree (with the
+/// correction for binning and the read's blur).
 struct HarmonicEstimate {
   SphereMap estimate;
   int degree = 0;
@@ -222,8 +225,9 @@ struct HarmonicEstimate {
 };
 
 /// The degree harmonic_estimate expands maps of resolution R to: min(R, 96). 96 holds a cos^200 lobe
-/// (its power at l = 72 is e⁻¹³ of its peak's) and leaves the top quarter of the degrees for the noise
-/// estimate; the cost is (L+1)² operations per texel each way (0.3 s for R 128 on one core).
+/// (its coefficient at l = 72 is e⁻¹³ of its first, its power e⁻²⁶) and leaves the top quarter of the
+/// degrees for the noise estimate; the cost is (L+1)² operations per texel pair each way (R 128: 466 ms on
+/// one thread, 241 ms on two; `lumx_bench_builder --benchmark_filter=harmonic_estimate`).
 inline int harmonic_estimate_degree(int resolution) {
   return std::min(resolution, 96);
 }
@@ -231,7 +235,11 @@ inline int harmonic_estimate_degree(int resolution) {
 /// The map's density (one channel: the sum of its channels) estimated by shrinking each degree of its
 /// harmonic expansion (see above): ĉ_lm · w_l / B_l with w_l = max(0, 1 − N̂_l / P̂_l), N̂_l = (2l+1)·v̂,
 /// made non-increasing in l (a smooth lobe's Wiener weights fall with l; a noise degree that happens to
-/// exceed N̂_l past the cut-off would only add noise),
+/// exceed N̂_l past the cut-off would only add noise). That cut-off is for lobes: where an emitter's
+/// power vanishes at some degree below its own cut-off (a Lambertian hemisphere at every odd l ≥ 3,
+/// equal up- and down-light at every odd l), it stops there and the estimate is too smooth; the held-out
+/// fit then does not choose it (local linear serves such emitters). `known_noise` > 0 replaces v̂ (for
+/// rays of equal flux Φ/n, (Φ/n)·Φ/(4π) in the map's units, when the caller knows n),
 /// v̂ the mean power per coefficient over the top quarter of the degrees (⌈3L/4⌉..L), and B_l the read
 /// blur's transfer. Degree 0 (the flux) is kept. The result, flux per texel at the texel centres, is
 /// clamped at 0 (the expansion rings where the map is dark) and rescaled to the map's flux. A map with
@@ -283,7 +291,7 @@ inline HarmonicEstimate harmonic_estimate(const SphereMap& map, unsigned threads
 /// texel of one asked for before comes again: the levels of a set sum the same rays in different orders,
 /// so their sums differ by float rounding only, and the held-out fit asks for each level's sum at every
 /// width it tries. One cache per fit (not process-wide), so a result never depends on what an earlier
-/// build asked for.
+/// build asked for. Not thread-safe: one per caller.
 class HarmonicEstimateCache {
  public:
   /// harmonic_estimate(map, threads).estimate, or the one of a map found equal as above.
@@ -302,7 +310,7 @@ class HarmonicEstimateCache {
   }
 
  private:
-  std::vector<std::pair<SphereMap, SphereMap>> entries_;
+  std::deque<std::pair<SphereMap, SphereMap>> entries_;  // a deque: references stay valid as it grows
 };
 
 LUMX_NAMESPACE_END

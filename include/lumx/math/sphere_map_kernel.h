@@ -65,8 +65,11 @@ inline const char* kernel_mode_name(KernelMode mode) {
 }
 
 /// sum (one channel) += the sum of `map`'s channels, texel by texel (same resolution): the one-channel
-/// total a level's gains are computed from.
+/// total a level's gains are computed from. Throws std::invalid_argument for another resolution.
 inline void accumulate_channels(SphereMap& sum, const SphereMap& map) {
+  if (sum.resolution() != map.resolution())
+    throw std::invalid_argument("accumulate_channels: a map of resolution " + std::to_string(map.resolution()) +
+                                " into one of " + std::to_string(sum.resolution()));
   const int C = map.channels();
   for (std::size_t t = 0; t < sum.texel_count(); ++t)
     for (int c = 0; c < C; ++c) sum.data()[t] += map.data()[t * std::size_t(C) + std::size_t(c)];
