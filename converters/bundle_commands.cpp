@@ -66,7 +66,10 @@ int run_bundle_info(const InfoArgs& a) {
           disk += p.bytes;
         }
         json frame = json::array();
-        for (int r = 0; r < 3; ++r) frame.push_back({l.frame.to_map[0][r], l.frame.to_map[1][r], l.frame.to_map[2][r]});
+        for (int r = 0; r < 3; ++r) {
+          const glm::vec3 row = l.frame.row(r);
+          frame.push_back({row.x, row.y, row.z});
+        }
         levels.push_back({{"apls", l.apl_count()},
                           {"map_resolution", l.map_resolution},
                           {"map_frame", frame},

@@ -294,11 +294,13 @@ void bind_bundle(py::module_& m) {
       .def_property_readonly(
           "map_frame",
           [](const Level& l) {
-            const glm::mat3& to_map = l.data->level().frame.to_map;
+            const lumx::MapFrame& frame = l.data->level().frame;
             py::array_t<float> out({py::ssize_t(3), py::ssize_t(3)});
             float* o = out.mutable_data();
-            for (int r = 0; r < 3; ++r)
-              for (int c = 0; c < 3; ++c) o[3 * r + c] = to_map[c][r];
+            for (int r = 0; r < 3; ++r) {
+              const glm::vec3 row = frame.row(r);
+              o[3 * r] = row.x, o[3 * r + 1] = row.y, o[3 * r + 2] = row.z;
+            }
             return out;
           },
           "3 x 3 rotation from the photometric frame to the maps' frame: a direction w reads the maps at "

@@ -57,6 +57,8 @@ struct MapFrame {
   glm::vec3 map_direction(const glm::vec3& w) const { return to_map * w; }
   glm::vec3 world_direction(const glm::vec3& m) const { return glm::transpose(to_map) * m; }
   bool is_identity() const { return to_map == glm::mat3(1.0f); }
+  /// Row r of to_map (glm stores columns): the map's axis r in the photometric frame, as files store it.
+  glm::vec3 row(int r) const { return {to_map[0][r], to_map[1][r], to_map[2][r]}; }
   /// Largest |(RᵀR − I)_ij| and the determinant: how far from a proper rotation the matrix is.
   std::pair<float, float> deviation() const {
     const glm::mat3 p = glm::transpose(to_map) * to_map;

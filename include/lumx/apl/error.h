@@ -949,16 +949,19 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     // Every eligible candidate (past the kernel guards) with its model values, for the one-standard-error
     // rule below, and its gain (empty for plain), to smooth the level with once chosen; the best is one
     // of them.
-    std::vector<std::pair<FitCandidate, std::vector<std::vector<double>>>> eligible;
-    std::vector<SphereMap> eligible_gain;
+    struct Eligible {
+      FitCandidate candidate;
+      std::vector<std::vector<double>> values;  // per sphere and patch
+      SphereMap gain;
+    };
+    std::vector<Eligible> eligible;
     std::vector<std::vector<double>> last_values;  // the model values of the candidate graded last
     std::size_t best_at = 0;
     // The distances the cost sums over (see above): every one, except for level 0, where the first
     // grade (the built maps unsmoothed) sets them.
     std::vector<bool> serves;
     const auto admit = [&](SphereMap gain) {
-      eligible.emplace_back(tried.back(), std::move(last_values));
-      eligible_gain.push_back(std::move(gain));
+      eligible.push_back({tried.back(), std::move(last_values), std::move(gain)});
       if (tried.back().cost < best.cost) best = tried.back(), best_at = eligible.size() - 1;
     };
     const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
@@ -1059,13 +1062,13 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     // R 64 and was 4.3 % off at d = 10 against 3.1 %; the suite's far-field test refused it).
     const double scale = double(best.resolution) / double(std::max(1, built.map_resolution));
     if (!eligible.empty() && double(built.map_bytes()) * scale * scale > kParsimonyBytes) {
-      const std::vector<std::vector<double>>& best_values = eligible[best_at].second;
+      const std::vector<std::vector<double>>& best_values = eligible[best_at].values;
       std::size_t simpler = best_at;
       for (std::size_t i = 0; i < eligible.size(); ++i) {
-        const FitCandidate& c = eligible[i].first;
-        const FitCandidate& s = eligible[simpler].first;
+        const FitCandidate& c = eligible[i].candidate;
+        const FitCandidate& s = eligible[simpler].candidate;
         if (c.resolution > s.resolution) continue;
-        if (!(c.cost <= best.cost + cost_difference_standard_error(ref, best_values, eligible[i].second, serves)))
+        if (!(c.cost <= best.cost + cost_difference_standard_error(ref, best_values, eligible[i].values, serves)))
           continue;
         if (c.resolution < s.resolution || c.cost < s.cost) simpler = i;
       }
@@ -1074,17 +1077,17 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       // where a worse one passes (an LED strip's 256-APL level, once a spectral candidate at R 128 was
       // best, went to R 32 unsmoothed, 5.3 % off at d = 1, where R 32 sharpened was 4.3 %).
       for (std::size_t i = 0; i < eligible.size(); ++i)
-        if (eligible[i].first.resolution == eligible[simpler].first.resolution &&
-            eligible[i].first.cost < eligible[simpler].first.cost)
+        if (eligible[i].candidate.resolution == eligible[simpler].candidate.resolution &&
+            eligible[i].candidate.cost < eligible[simpler].candidate.cost)
           simpler = i;
-      best = eligible[simpler].first;
+      best = eligible[simpler].candidate;
       best_at = simpler;
     }
     set.levels[k] = downsampled_level(built, best.resolution);
     // Smoothed with the gain the candidate was graded with (the level sum's at that resolution).
     if (best.kappa > 0)
       set.levels[k] = smoothed_level_with_gain(set.levels[k], *kernel_for(best.resolution, best.kappa), best.mode,
-                                               eligible_gain.at(best_at));
+                                               eligible.at(best_at).gain);
     choice.resolution.push_back(best.resolution);
     choice.kappa.push_back(best.kappa);
     choice.mode.push_back(best.kappa > 0 ? best.mode : KernelMode::plain);

@@ -165,8 +165,10 @@ std::string manifest_to_json(const BundleManifest& m) {
     level["map_resolution"] = l.map_resolution;
     if (!l.frame.is_identity()) {  // rows: the map's axes in the photometric frame
       json rows = json::array();
-      for (int r = 0; r < 3; ++r)
-        rows.push_back(json::array({double(l.frame.to_map[0][r]), double(l.frame.to_map[1][r]), double(l.frame.to_map[2][r])}));
+      for (int r = 0; r < 3; ++r) {
+        const glm::vec3 row = l.frame.row(r);
+        rows.push_back(json::array({double(row.x), double(row.y), double(row.z)}));
+      }
       level["map_frame"] = rows;
     }
     json pos = json::array(), flux = json::array();
