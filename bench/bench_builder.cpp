@@ -13,6 +13,9 @@
 //   build_file/N/T   what `lumx build FILE OUT --threads T` does on an N-ray TM-25 file, by phase
 //   harmonic_estimate/R/T   the spectral pilot of one level sum (math/sphere_map_harmonics.h): expansion to
 //                    degree min(R, 96), shrinkage, synthesis, on a map of 10⁶ rays of a cos^20 lobe, T threads
+//   kernel_apply/R/N  one SphereMapKernel::apply (σ 3 texel widths) to a map of N rays of a cos^20 lobe at
+//                    R: an APL's sparse map of a 512-APL level (N ≈ 2 000) and a level sum (N = 10⁶); the
+//                    held-out fit smooths every map of a level once per kernel it tries
 // Rays: 64 emitters on a 0.3 m ring, 1 mm discs, cos³ lobes tilted outwards, in memory (SoA floats).
 #include <lumx/apl/builder.h>
 #include <lumx/apl/error.h>
@@ -22,6 +25,7 @@
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/rayset_io.h>
 #include <lumx/math/sphere_map_harmonics.h>
+#include <lumx/math/sphere_map_kernel.h>
 
 #include <unistd.h>
 
@@ -189,20 +193,36 @@ BENCHMARK(build_file)->Args({1000000, 2})->Args({10000000, 2})->Unit(benchmark::
 }  // namespace
 
 namespace {
-void harmonic_estimate_bench(benchmark::State& state) {
-  const int R = int(state.range(0));
+/// `rays` rays of a cos^20 lobe about −z binned at R, one channel.
+SphereMap cos20_lobe_map(int R, int rays) {
   SphereMap map(R, 1);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (int i = 0; i < 1000000; ++i) {
+  for (int i = 0; i < rays; ++i) {
     const double ct = std::pow(u(rng), 1.0 / 21.0), st = std::sqrt(1 - ct * ct), phi = 2 * kPi * u(rng);
     int x, y;
     map.texel_of(glm::vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(-ct)), x, y);
     map.at(x, y, 0) += 1.0f;
   }
+  return map;
+}
+
+void harmonic_estimate_bench(benchmark::State& state) {
+  const SphereMap map = cos20_lobe_map(int(state.range(0)), 1000000);
   for (auto _ : state) benchmark::DoNotOptimize(harmonic_estimate(map, unsigned(state.range(1))).estimate.data());
 }
 }  // namespace
 BENCHMARK(harmonic_estimate_bench)->Name("harmonic_estimate")->ArgsProduct({{32, 64, 128}, {1, 2}})->Unit(benchmark::kMillisecond);
+
+namespace {
+void kernel_apply(benchmark::State& state) {
+  const int R = int(state.range(0));
+  const SphereMap map = cos20_lobe_map(R, int(state.range(1)));
+  const double texel = std::sqrt(4.0 * kPi / (2.0 * double(R) * double(R)));
+  const auto kernel = SphereMapKernel::shared(R, 1.0 / ((3 * texel) * (3 * texel)));
+  for (auto _ : state) benchmark::DoNotOptimize(kernel->apply(map).data());
+}
+}  // namespace
+BENCHMARK(kernel_apply)->ArgsProduct({{32, 128}, {2000, 1000000}})->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();

@@ -36,6 +36,8 @@ lumx::BundleBuildOptions bundle_options(const BuildArgs& a) {
   bo.seed_rays = a.seed_rays;
   bo.map_resolution = a.map_resolution;
   bo.rays_per_texel = a.rays_per_texel;
+  bo.min_resolution = std::min(bo.min_resolution, a.max_resolution);
+  bo.max_resolution = a.max_resolution;
   bo.place_at_convergence = a.converge;
   using LC = lumx::AplBuildOptions::LineClustering;
   bo.line_clustering = a.cluster_by == "start" ? LC::start_points : a.cluster_by == "line" ? LC::lines : LC::automatic;

@@ -18,6 +18,7 @@ struct BuildArgs {
   std::size_t seed_rays = 250000;    ///< --seeds
   int map_resolution = 0;            ///< --map-resolution (0: by the rays-per-texel rule)
   double rays_per_texel = 8;         ///< --rays-per-texel
+  int max_resolution = 128;          ///< --max-resolution: the finest R the rule may give
   int patch_resolution = 16;         ///< --patches R for the error evaluation
   bool no_eval = false;              ///< --no-eval: skip the error evaluation (no error tables)
   double c_step_deg = 2.5, gamma_step_deg = 1.0;  ///< far-field grid

@@ -146,6 +146,10 @@ const Command kCommands[] = {
            ->check(CLI::Range(0, 4096));
        c.add_option("--rays-per-texel", g_build.rays_per_texel, "the resolution rule's target (default 8)")
            ->check(CLI::PositiveNumber);
+       c.add_option("--max-resolution", g_build.max_resolution,
+                    "the finest map resolution R the rule may give, and so the finest the held-out fit tries "
+                    "(default 128; smaller bundles and a faster fit)")
+           ->check(CLI::Range(1, 4096));
        c.add_option("--patches", g_build.patch_resolution, "error evaluation: N = 2R^2 patches per sphere (default 16)")
            ->check(CLI::Range(1, 1024));
        c.add_flag("--no-eval", g_build.no_eval, "skip the error evaluation (no error tables)");
@@ -210,6 +214,10 @@ const Command kCommands[] = {
                     "--preview: sphere-map resolution R, a power of two (default 64: 128 x 64 texels)")
            ->check(CLI::IsMember({1, 2, 4, 8, 16, 32, 64, 128, 256, 512}));
        c.add_option("--levels", g_bake.build.levels, "APLs per level, increasing (default 1 8 64 256 512)");
+       c.add_option("--max-resolution", g_bake.build.max_resolution,
+                    "the finest map resolution R the rule may give, and so the finest the held-out fit tries "
+                    "(default 128; smaller bundles and a faster fit and grading)")
+           ->check(CLI::Range(1, 4096));
        c.add_flag("--no-eval", g_bake.build.no_eval, "skip the error evaluation (no error tables, no --target-error)");
        c.add_flag("--progress", g_bake.build.progress, "show the progress bar even when stderr is not a terminal");
        c.add_option("--threads", g_bake.build.threads, "threads (default: every core; the bundle is the same for "

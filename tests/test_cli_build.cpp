@@ -14,6 +14,7 @@
 
 #include "analytic_emitters.h"
 #include "cli_test_support.h"
+#include "test_support.h"
 
 #include <cmath>
 #include <filesystem>
@@ -37,7 +38,8 @@ struct BuiltDisk {
     rays = dir / "disk.tm25ray";
     bundle = dir / "disk.lumx";
     const lumx_test::PlanarEmitter disk("disk", lumx_test::PlanarEmitter::Shape::disk, 0.1, 0, 1, 1000);
-    auto src = disk.source(200000, 21);
+    // The sanitizer build runs the same commands on fewer rays, so that the rule and the fit give R 32 maps.
+    auto src = disk.source(lumx_test::kSanitized ? 50000 : 200000, 21);
     RaysetInfo info = src->info();
     info.header_flux = 1000;
     write_tm25(rays.string(), info, *src);
@@ -119,4 +121,24 @@ TEST(CliBuild, EvalOnTheBundlesOwnRaysRebuildsFromHalf) {
   ASSERT_EQ(forced.status, 0) << forced.out;
   EXPECT_TRUE(has(forced.out, "(the rays it was built from: errors shared with them cancel)")) << forced.out;
   EXPECT_FALSE(has(forced.out, "rebuilt from the even rays")) << forced.out;
+}
+
+TEST(CliBuild, MaxResolutionCapsEveryLevelsMaps) {
+  const fs::path dir = lumx_test::fresh_temp_dir("lumx_cli_build_cap");
+  const lumx_test::PlanarEmitter disk("disk", lumx_test::PlanarEmitter::Shape::disk, 0.1, 0, 1, 1000);
+  auto src = disk.source(100000, 5);
+  write_tm25((dir / "disk.tm25ray").string(), src->info(), *src);
+  // 100 000 rays give the one-APL level R 64 by the rule; the cap makes it and every other level at most 16.
+  const lumx_test::CliRun r = lumx_test::run_cli("build " + lumx_test::quoted(dir / "disk.tm25ray") + " " +
+                                                 lumx_test::quoted(dir / "b") + " --levels 1 8 --max-resolution 16");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const BundleReader bundle((dir / "b").string());
+  ASSERT_EQ(bundle.manifest().levels.size(), 2u);
+  for (const auto& level : bundle.manifest().levels) EXPECT_LE(level.map_resolution, 16);
+  EXPECT_TRUE(has(r.out, "1 APLs (R 16), 8 APLs (R 16) as built")) << r.out;
+  EXPECT_NE(lumx_test::run_cli("build " + lumx_test::quoted(dir / "disk.tm25ray") + " " + lumx_test::quoted(dir / "c") +
+                               " --max-resolution 0")
+                .status,
+            0);
+  fs::remove_all(dir);
 }

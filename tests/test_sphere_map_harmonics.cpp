@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <random>
 
 using namespace lumx;
@@ -42,18 +43,23 @@ SphereMap lobe_rays(int R, double m, const glm::dvec3& axis, int rays, std::uint
   return map;
 }
 
-/// Relative RMSE of a map's bilinear lookups (as a renderer reads it; density = value / Ω) against the lobe
-/// at `n` random directions, normalised by the mean density 1/4π (eq. 5.1's normalisation).
-double lookup_error(const SphereMap& map, double m, const glm::dvec3& axis, int n = 20000) {
+/// Relative RMSE of a unit-flux map's bilinear lookups (as a renderer reads it; density = value / Ω) against
+/// `density` (1/sr) at `n` random directions, normalised by the mean density 1/4π (eq. 5.1's normalisation).
+double lookup_error(const SphereMap& map, const std::function<double(const glm::dvec3&)>& density, int n = 20000) {
   std::mt19937_64 rng(99);
   const double omega = map.texel_solid_angle();
   double sq = 0;
   for (int i = 0; i < n; ++i) {
     const glm::dvec3 w = random_direction(rng);
-    const double d = double(map.lookup(glm::vec3(w)).x) / omega - lobe_density(m, axis, w);
+    const double d = double(map.lookup(glm::vec3(w)).x) / omega - density(w);
     sq += d * d;
   }
   return std::sqrt(sq / n) * 4 * kPi;
+}
+
+/// lookup_error against the cos^m lobe about `axis`.
+double lookup_error(const SphereMap& map, double m, const glm::dvec3& axis) {
+  return lookup_error(map, [&](const glm::dvec3& w) { return lobe_density(m, axis, w); });
 }
 
 /// A unit-flux cos^m lobe's Legendre coefficients a_l = (m+1) ∫₀¹ μ^m P_l(μ) dμ, l = 0..L (its density is
@@ -70,15 +76,25 @@ std::vector<double> lobe_legendre(double m, int L) {
   return a;
 }
 
-/// The oracle Wiener filter's relative RMSE (eq. 5.1's normalisation) for a zonal density of Legendre
-/// coefficients `a` from N rays: ε² = Σ_{l≥1} (2l+1) [(1 − w_l)² a_l² + w_l²/N], w_l = a_l²/(a_l² + 1/N).
-double oracle_wiener_error(const std::vector<double>& a, double N) {
+/// The relative RMSE (eq. 5.1's normalisation, the mean 1/4π) of a zonal density of Legendre coefficients
+/// `a` estimated from N rays by weighing degree l by weight(l): ε² = Σ_{l≥1} (2l+1) [(1 − w_l)² a_l² + w_l²/N],
+/// bias and white noise of (2l+1)/N per degree (the flux, l = 0, is known).
+template <class Weight>
+double zonal_error(const std::vector<double>& a, double N, Weight&& weight) {
   double e2 = 0;
   for (std::size_t l = 1; l < a.size(); ++l) {
-    const double w = a[l] * a[l] / (a[l] * a[l] + 1 / N);
+    const double w = weight(int(l));
     e2 += (2.0 * double(l) + 1) * ((1 - w) * (1 - w) * a[l] * a[l] + w * w / N);
   }
   return std::sqrt(e2);
+}
+
+/// zonal_error of the oracle Wiener filter, w_l = a_l²/(a_l² + 1/N): the least of any weights.
+double oracle_wiener_error(const std::vector<double>& a, double N) {
+  return zonal_error(a, N, [&](int l) {
+    const double power = a[std::size_t(l)] * a[std::size_t(l)];
+    return power / (power + 1 / N);
+  });
 }
 
 }  // namespace
@@ -178,16 +194,7 @@ TEST(SphereMapHarmonics, ShrunkEstimateFollowsEmittersWhosePowerVanishesAtAltern
       map.at(x, y, 0) += float(1.0 / rays);
     }
     const auto density = [&](const glm::dvec3& w) { return both ? std::abs(w.z) / (2 * kPi) : std::max(0.0, -w.z) / kPi; };
-    const auto error = [&](const SphereMap& m) {
-      std::mt19937_64 r(99);
-      double sq = 0;
-      for (int i = 0; i < 20000; ++i) {
-        const glm::dvec3 w = random_direction(r);
-        const double d = double(m.lookup(glm::vec3(w)).x) / m.texel_solid_angle() - density(w);
-        sq += d * d;
-      }
-      return std::sqrt(sq / 20000) * 4 * kPi;
-    };
+    const auto error = [&](const SphereMap& m) { return lookup_error(m, density); };
     const double oracle = oracle_wiener_error(both ? even : a, rays);
     const double e = error(harmonic_estimate(map, 2).estimate), binned = error(map);
     std::printf("  %s: shrunk expansion %.2f %%, oracle %.2f %%, binned %.2f %%\n",
@@ -210,21 +217,13 @@ TEST(SphereMapHarmonics, ShrunkEstimateFollowsEmittersWhosePowerVanishesAtAltern
 TEST(SphereMapHarmonics, WienerBoundsWhatAnyKernelCanDoOnALobe) {
   // The table of docs/apl_sets.md ("Spectral pilot"), computed from the lobes' Legendre coefficients, no
   // rays: a unit-flux cos^m lobe f = Σ_l (2l+1)/4π a_l P_l, a_l = (m+1) ∫₀¹ μ^m P_l(μ) dμ, estimated from N
-  // rays by weighing degree l by w_l has the relative RMSE (eq. 5.1's normalisation, the mean 1/4π)
-  // ε² = Σ_{l≥1} (2l+1) [(1 − w_l)² a_l² + w_l²/N]: bias, and white noise of (2l+1)/N per degree (the flux,
-  // l = 0, is known). Gaussian kernels of σ: plain K_l = exp(−l(l+1)σ²/2), sharpened K(2 − K), extrapolated
+  // rays by weighing degree l by w_l has the relative RMSE zonal_error. Gaussian kernels of σ: plain
+  // K_l = exp(−l(l+1)σ²/2), sharpened K(2 − K), extrapolated
   // 3K − 3K² + K³, at their best σ on a 0.1° grid (0.3°–10°); Wiener w_l = a_l²/(a_l² + 1/N), the least ε²
   // of any weights. Checked to 0.01 points against the documented figures.
   const int L = 600;
   const auto coefficients = [&](double m) { return lobe_legendre(m, L); };
-  const auto error = [&](const std::vector<double>& a, double N, auto&& weight) {
-    double e2 = 0;
-    for (int l = 1; l <= L; ++l) {
-      const double w = weight(l);
-      e2 += (2 * l + 1) * ((1 - w) * (1 - w) * a[l] * a[l] + w * w / N);
-    }
-    return 100 * std::sqrt(e2);
-  };
+  const auto error = [](const std::vector<double>& a, double N, auto&& weight) { return 100 * zonal_error(a, N, weight); };
   struct Row {
     double m, N, plain, sharpened, extrapolated, wiener;
   };
@@ -232,7 +231,7 @@ TEST(SphereMapHarmonics, WienerBoundsWhatAnyKernelCanDoOnALobe) {
                             {50, 1e6, 8.72, 4.72, 3.81, 2.62}, {50, 4e6, 0, 0, 0, 1.40}};
   for (const Row& row : documented) {
     const std::vector<double> a = coefficients(row.m);
-    const double wiener = error(a, row.N, [&](int l) { return a[l] * a[l] / (a[l] * a[l] + 1 / row.N); });
+    const double wiener = 100 * oracle_wiener_error(a, row.N);
     double best[3] = {INFINITY, INFINITY, INFINITY};
     for (int i = 3; i <= 100; ++i) {
       const double s = i * 0.1 * kPi / 180;

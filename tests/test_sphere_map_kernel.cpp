@@ -124,6 +124,13 @@ TEST(SphereMapKernel, GridSearchAndSparseScatterAgreeWithTheDefinitionBitForBit)
           differing += out.values()[std::size_t(t) * 3 + std::size_t(c)] != float(v);
         }
       EXPECT_EQ(differing, 0) << "kappa " << kappa << (in == &sparse ? ", sparse map" : ", dense map");
+      // A one-channel map (every APL's) takes its own loop: the same sums as that channel of three.
+      SphereMap one(R, 1);
+      for (int t = 0; t < T; ++t) one.values()[std::size_t(t)] = in->values()[std::size_t(t) * 3 + 1];
+      const SphereMap one_out = k.apply(one);
+      int differing_one = 0;
+      for (int t = 0; t < T; ++t) differing_one += one_out.values()[std::size_t(t)] != out.values()[std::size_t(t) * 3 + 1];
+      EXPECT_EQ(differing_one, 0) << "kappa " << kappa << (in == &sparse ? ", sparse map" : ", dense map");
     }
   }
 }
@@ -190,6 +197,17 @@ TEST(SphereMapKernel, SmoothedLevelIsTheSameForAnyThreadCount) {
     EXPECT_EQ(one.apls[i].map.values(), three.apls[i].map.values()) << i;
     EXPECT_NEAR(map_sum(one.apls[i].map), map_sum(level.apls[i].map), 1e-5 * (1 + map_sum(level.apls[i].map)));
   }
+  // The fit smooths each map once per kernel and reuses K·f for every mode: the same bits as smoothing anew.
+  const std::vector<SphereMap> applied = kernel_applied_maps(level, k, 2);
+  for (KernelMode mode : {KernelMode::plain, KernelMode::sharpened, KernelMode::local_linear}) {
+    const SphereMap gain = mode == KernelMode::plain ? SphereMap() : k.gain(level_sum(level), mode);
+    const AplLevel fresh = smoothed_level_with_gain(level, k, mode, gain, 1);
+    const AplLevel reused = level_from_applied(level, applied, k, mode, gain, 3);
+    for (std::size_t i = 0; i < level.apls.size(); ++i)
+      EXPECT_EQ(fresh.apls[i].map.values(), reused.apls[i].map.values()) << kernel_mode_name(mode) << " " << i;
+  }
+  EXPECT_THROW(level_from_applied(level, std::vector<SphereMap>(3), k, KernelMode::plain, SphereMap()),
+               std::invalid_argument);
 }
 
 TEST(SphereMapKernel, PeakGuardRefusesToFlattenANarrowLobeButNotABroadOne) {

@@ -728,6 +728,26 @@ inline int fit_patch_resolution(int patch_resolution, std::uint64_t rays) {
   return R;
 }
 
+namespace detail {
+/// body(i) for i in [0, n), split into contiguous ranges over up to `threads` threads (0: the hardware's,
+/// at most 8; one per 8 items at least), for work whose items are independent.
+template <class Body>
+void for_each_map(std::size_t n, unsigned threads, Body&& body) {
+  if (threads == 0) threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
+  threads = unsigned(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 8)));
+  const auto run = [&](std::size_t from, std::size_t to) {
+    for (std::size_t i = from; i < to; ++i) body(i);
+  };
+  if (threads <= 1) {
+    run(0, n);
+    return;
+  }
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(run, n * t / threads, n * (t + 1) / threads);
+  for (std::thread& t : pool) t.join();
+}
+}  // namespace detail
+
 /// The level's maps box-downsampled to resolution R (a power-of-two fraction of theirs; else throws).
 inline AplLevel downsampled_level(const AplLevel& level, int R) {
   AplLevel out = level;
@@ -749,29 +769,40 @@ inline SphereMap level_sum(const AplLevel& level) {
   return total;
 }
 
+/// K·f of every map of `level` (`kernel`'s resolution), on up to `threads` threads (0: the hardware's): what
+/// every mode of one kernel starts from (SphereMapKernel::with_gain). Each map is smoothed alone, so the
+/// result does not depend on the thread count.
+inline std::vector<SphereMap> kernel_applied_maps(const AplLevel& level, const SphereMapKernel& kernel,
+                                                  unsigned threads = 0) {
+  std::vector<SphereMap> out(level.apls.size());
+  detail::for_each_map(out.size(), threads, [&](std::size_t i) { out[i] = kernel.apply(level.apls[i].map); });
+  return out;
+}
+
+/// The level's maps as `kernel` in `mode` smooths them, from their K·f already taken (`applied`,
+/// kernel_applied_maps) and `gain` from the level's sum (kernel.gain(level_sum(level), mode); not read in
+/// plain mode): the same bits as smoothing each map afresh.
+inline AplLevel level_from_applied(const AplLevel& level, std::vector<SphereMap> applied,
+                                   const SphereMapKernel& kernel, KernelMode mode, const SphereMap& gain,
+                                   unsigned threads = 0) {
+  if (applied.size() != level.apls.size())
+    throw std::invalid_argument("level_from_applied: " + std::to_string(applied.size()) + " smoothed maps for " +
+                                std::to_string(level.apls.size()) + " APLs");
+  AplLevel out = level;
+  const bool with_gain = mode != KernelMode::plain;
+  detail::for_each_map(out.apls.size(), threads, [&](std::size_t i) {
+    out.apls[i].map = with_gain ? kernel.with_gain(level.apls[i].map, std::move(applied[i]), gain) : std::move(applied[i]);
+  });
+  return out;
+}
+
 /// The level's maps smoothed by `kernel` (whose resolution must be theirs) in `mode` with `gain` already
 /// taken from the level's sum (kernel.gain(level_sum(level), mode); not read in plain mode), on up to
 /// `threads` threads (0: the hardware's). Each map is smoothed alone, so the result does not depend on the
 /// thread count.
 inline AplLevel smoothed_level_with_gain(const AplLevel& level, const SphereMapKernel& kernel, KernelMode mode,
                                          const SphereMap& gain, unsigned threads = 0) {
-  AplLevel out = level;
-  const std::size_t n = out.apls.size();
-  if (threads == 0) threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
-  threads = unsigned(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 8)));
-  const bool with_gain = mode != KernelMode::plain;
-  const auto run = [&](std::size_t from, std::size_t to) {
-    for (std::size_t i = from; i < to; ++i)
-      out.apls[i].map = with_gain ? kernel.apply_with_gain(level.apls[i].map, gain) : kernel.apply(level.apls[i].map);
-  };
-  if (threads <= 1) {
-    run(0, n);
-  } else {
-    std::vector<std::thread> pool;
-    for (unsigned t = 0; t < threads; ++t) pool.emplace_back(run, n * t / threads, n * (t + 1) / threads);
-    for (std::thread& t : pool) t.join();
-  }
-  return out;
+  return level_from_applied(level, kernel_applied_maps(level, kernel, threads), kernel, mode, gain, threads);
 }
 
 /// The level's maps smoothed by `kernel` in `mode`. Any mode but plain takes one gain from the level's sum
@@ -929,6 +960,11 @@ inline double cost_difference_standard_error(const ReferenceIrradiance& ref, con
 /// 8 MiB a 512-APL bundle from 1 M rays is given.
 inline constexpr double kParsimonyBytes = 1024.0 * 1024.0;
 
+/// The memory fit_map_resolutions may keep a level's smoothed maps in, to reuse them across the modes of one
+/// kernel width: 128 MiB, two widths of a 512-APL level at R 128 (a 1 M-ray LED strip: 43.1 → 36.4 s,
+/// 914 → 1 046 MB peak resident; with three, 37.1 s and 1 111 MB).
+inline constexpr double kAppliedBytes = 128.0 * 1024.0 * 1024.0;
+
 /// The error beyond which the kernel guard of fit_map_resolutions does not protect a distance (relative RMSE).
 inline constexpr double kUnusableError = 0.25;
 
@@ -990,6 +1026,22 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       // The cost of the last two-scale candidate admitted at this R, and whether a wider one may still win.
       double two_scale_before = INFINITY, spectral_before = INFINITY;
       bool two_scale_improving = true, spectral_improving = true;
+      // K·f of every map, per kernel width at this R, kept for the other modes of that width (1.5 and 3
+      // texel widths serve five or six candidates each): the widths used last, as many as kAppliedBytes
+      // holds, at most three (a width smoothed once or twice per R, not once per candidate; the same bits).
+      std::vector<std::pair<double, std::vector<SphereMap>>> applied;  // least recently used first
+      const std::size_t applied_kept = std::size_t(
+          std::clamp(kAppliedBytes / std::max(1.0, double(at_r.map_bytes())), 1.0, 3.0));
+      const auto applied_for = [&](const SphereMapKernel& kern) -> const std::vector<SphereMap>& {
+        for (std::size_t i = 0; i < applied.size(); ++i)
+          if (applied[i].first == kern.kappa()) {
+            std::rotate(applied.begin() + std::ptrdiff_t(i), applied.begin() + std::ptrdiff_t(i) + 1, applied.end());
+            return applied.back().second;
+          }
+        if (applied.size() >= applied_kept) applied.erase(applied.begin());
+        applied.emplace_back(kern.kappa(), kernel_applied_maps(at_r, kern));
+        return applied.back().second;
+      };
       for (const FitKernel& kernel : set_rays > 0 && !at_r.apls.empty() ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
         // Two-scale keeps the level's sum sharp at a distance, so only where the maps are fine enough to
@@ -1023,7 +1075,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         const auto [lowering, allowance] = kernel_peak_change(
             sum_at_r, plain_mode ? kern.apply(sum_at_r) : kern.apply_with_gain(sum_at_r, gain), set_rays);
         if (lowering > allowance) continue;
-        set.levels[k] = smoothed_level_with_gain(at_r, kern, kernel.mode, gain);
+        set.levels[k] = level_from_applied(at_r, applied_for(kern), kern, kernel.mode, gain);
         grade(R, kappa, kernel.mode, kernel_errors);
         // A kernel must not give away any distance against the same maps unsmoothed: its bias is largest at
         // a narrow peak, which patches coarser than the peak see only in part, at some distances

@@ -68,6 +68,7 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
   // being paid one after another (performance.md §3c: the limit is misses in flight, not bandwidth).
   constexpr std::size_t kChunk = 32;
   const glm::mat3 to_map = level.frame.to_map;
+  const bool turned = !level.frame.is_identity();  // most sets: skip the 3×3 multiply per APL
   SphereMap::Footprint footprints[kChunk];
   float weights[kChunk];
   std::size_t index[kChunk];
@@ -89,7 +90,7 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
       if (cosine <= 0.0f) continue;
       const float v = visibility(i, a.position, x);
       if (v <= 0.0f) continue;
-      footprints[count] = a.map.footprint(to_map * w);
+      footprints[count] = a.map.footprint(turned ? to_map * w : w);
       for (const float* t : footprints[count].texel) __builtin_prefetch(t);
       weights[count] = cosine * v / r2;
       index[count] = i;

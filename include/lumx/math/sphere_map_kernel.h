@@ -202,7 +202,14 @@ class SphereMapKernel {
     const float* src = in.data();
     const std::size_t T = offsets_.size() - 1;
     std::vector<double> sum(T * std::size_t(C), 0.0);
-    for (std::size_t s = 0; s < T; ++s) {
+    if (C == 1) {  // every APL map: the same sums without the channel loop
+      for (std::size_t s = 0; s < T; ++s) {
+        if (src[s] == 0.0f) continue;
+        const double v = double(src[s]);
+        for (std::uint32_t i = offsets_[s]; i < offsets_[s + 1]; ++i) sum[targets_[i]] += double(weights_[i]) * v;
+      }
+    }
+    for (std::size_t s = 0; s < T && C != 1; ++s) {
       if (!lit(src, s, C)) continue;
       for (std::uint32_t i = offsets_[s]; i < offsets_[s + 1]; ++i)
         for (int c = 0; c < C; ++c)
@@ -348,7 +355,17 @@ class SphereMapKernel {
   SphereMap apply_with_gain(const SphereMap& in, const SphereMap& gain) const {
     if (gain.resolution() != resolution_ || gain.channels() != 1)
       throw std::invalid_argument("SphereMapKernel: the gain must be one channel at the kernel's resolution");
-    SphereMap out = apply(in);
+    return with_gain(in, apply(in), gain);
+  }
+
+  /// apply_with_gain(in, gain) from `smoothed` = apply(in), to the same bits: every mode of one kernel starts
+  /// from K·f, so a caller trying several modes (the held-out fit) smooths each map once.
+  SphereMap with_gain(const SphereMap& in, SphereMap smoothed, const SphereMap& gain) const {
+    if (gain.resolution() != resolution_ || gain.channels() != 1)
+      throw std::invalid_argument("SphereMapKernel: the gain must be one channel at the kernel's resolution");
+    if (smoothed.resolution() != in.resolution() || smoothed.channels() != in.channels() || in.resolution() != resolution_)
+      throw std::invalid_argument("SphereMapKernel: the smoothed map must be the input's, at the kernel's resolution");
+    SphereMap out = std::move(smoothed);
     const int C = in.channels();
     const std::size_t T = out.texel_count();
     for (int c = 0; c < C; ++c) {
