@@ -13,9 +13,9 @@ if [ "${1:-}" = "--sanitize" ]; then
   # Accuracy checks and a real-file sweep that only repeat, at ten times the cost under the sanitizers,
   # code paths the smaller tests of the same modules already run there; the release run (the README's
   # command) keeps them. (The estimate of a 10⁶-ray lobe at R 128, the pilot's centring of a spot's
-  # patches and the noise-free spot study run in WienerBounds…, SpectralMaps…, the held-out suite's box
-  # and the bakes' fits there.) The longest remaining tests run a short form (tests/test_support.h,
-  # kSanitized).
+  # patches and the noise-free spot study run in WienerBounds…, SpectralMaps…, the CLI's builds and the
+  # bakes' fits there; the held-out and shipped-set suites skip themselves.) The longest remaining tests
+  # run a short form (tests/test_support.h, kSanitized).
   skip=(-E '^(AplErrorMeasured\.(RealTm25FilesMeetTheNoiseFloor|OsramBlueLedMeetsTheNoiseFloor)|SphericalKernelDensityAccuracy\..*|BakeExactIrradiance\..*|AplFarField\.RealPhotometryRoundTripsThroughAnApl|Tm33\.EveryRealIesAndLdtFileRoundTrips|AplBuilder\.(ClustersByLineOnlyWhenTheLinesMeet|ConvergencePlacementFindsAnEnclosedEmitter)|CliBuild\.StoresAndPrintsHeldOutTablesTheLibraryReproduces|SphereMapHarmonics\.ShrunkEstimate.*|FitReference\.ThePilotsShapeMovesPatchMeansToPatchCentres|SphereMapKernel\.NoiseFreeSpotsShowWhatTexelMapsCanDo)$')
 fi
 ctest --test-dir "$dir" --output-on-failure -j "$(nproc)" "${skip[@]}"

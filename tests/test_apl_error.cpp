@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "rayset_test_support.h"
 
 #include <filesystem>
@@ -312,6 +314,7 @@ TEST(AplErrorLevels, ErrorDecreasesWithLevelNearAndAgreesFarAway) {
   ASSERT_EQ(set.levels.size(), 4u);
   AplErrorOptions o;
   o.min_timing_seconds = 0;
+  o.threads = 1;  // timed: the untimed points run on one thread
   const AplErrorReport r = evaluate_apl_errors(set, rays, o);
   ASSERT_EQ(r.levels.size(), 4u);
   const auto& spheres = r.reference.sphere;
@@ -448,21 +451,77 @@ TEST(AplErrorLevels, RaysFromOnePointGiveNoiseForEveryLevel) {
     }
 }
 
-TEST(AplErrorLevels, DeterministicWhateverTheChunkSize) {
+TEST(AplErrorLevels, DeterministicWhateverTheChunkSizeAndThreadCount) {
   MemoryRaySource rays = ring_rays(60000, 21);
   const AplSet set = build_fixed(rays, 16, {1, 8, 64});
   AplErrorOptions a, b;
   a.min_timing_seconds = b.min_timing_seconds = 0;
   a.chunk_rays = 65536;
   b.chunk_rays = 777;
+  a.threads = 1;
+  b.threads = 3;  // more threads than cores: the split, not the machine, is what must not matter
   const AplErrorReport ra = evaluate_apl_errors(set, rays, a), rb = evaluate_apl_errors(set, rays, b);
   for (std::size_t s = 0; s < ra.reference.sphere.size(); ++s) {
     EXPECT_EQ(ra.reference.sphere[s].irradiance, rb.reference.sphere[s].irradiance);
     EXPECT_EQ(ra.reference.sphere[s].noise_floor, rb.reference.sphere[s].noise_floor);
     for (std::size_t k = 0; k < ra.levels.size(); ++k) {
+      EXPECT_EQ(ra.levels[k].irradiance[s], rb.levels[k].irradiance[s]);
       EXPECT_EQ(ra.levels[k].errors[s].relative_rmse, rb.levels[k].errors[s].relative_rmse);
       EXPECT_EQ(ra.levels[k].errors[s].hellinger, rb.levels[k].errors[s].hellinger);
     }
+  }
+  for (std::size_t k = 0; k < ra.levels.size(); ++k) {
+    EXPECT_EQ(ra.levels[k].clamped, rb.levels[k].clamped);
+    // Timed on one thread only: one untimed pass over three threads reports no time.
+    EXPECT_GT(ra.levels[k].ns_per_evaluation, 0);
+    EXPECT_TRUE(std::isnan(rb.levels[k].ns_per_evaluation));
+  }
+  // With a timing asked for, the points run on three threads and the timing repeats on one.
+  b.min_timing_seconds = 1e-6;
+  const LevelErrors timed = evaluate_level(set, 2, rb.reference, b);
+  EXPECT_EQ(timed.irradiance, rb.levels[2].irradiance);
+  EXPECT_GT(timed.ns_per_evaluation, 0);
+}
+
+// The fit grades every candidate at one resolution through the lookups of the first: the same bits as
+// evaluate_level, for maps of other values, in a turned frame, with clamped distances; another layout or
+// another reference is refused.
+TEST(AplErrorLevels, LookupsKeptForALayoutGiveEvaluateLevelsBits) {
+  MemoryRaySource rays = ring_rays(60000, 23);
+  AplSet set = build_fixed(rays, 16, {1, 8, 64});
+  AplErrorOptions o;
+  o.min_timing_seconds = 0;
+  o.irradiance.min_distance = 0.5 * set.bounds.radius;  // points at d = 0.5 come that close to APLs
+  const ReferenceIrradiance ref = gather_reference(rays, set.bounds, o);
+  for (const bool turned : {false, true}) {
+    if (turned) set.levels[2].frame.to_map = glm::mat3(glm::rotate(glm::mat4(1.0f), 0.7f, glm::normalize(glm::vec3(1, 2, 3))));
+    ASSERT_EQ(set.levels[2].frame.is_identity(), !turned);
+    const lumx::detail::LevelLookups lookups(set, 2, ref, o);
+    for (int candidate = 0; candidate < 2; ++candidate) {
+      if (candidate == 1)  // other values in the same layout, as a smoothing gives
+        for (Apl& a : set.levels[2].apls)
+          for (std::size_t t = 0; t < a.map.texel_count() * std::size_t(a.map.channels()); ++t)
+            a.map.data()[t] *= 1.0f + 0.5f * std::sin(float(t));
+      for (const unsigned threads : {1u, 2u}) {
+        o.threads = threads;
+        const LevelErrors direct = evaluate_level(set, 2, ref, o), kept = lookups.evaluate(set, 2, ref, o);
+        EXPECT_EQ(kept.irradiance, direct.irradiance) << turned << candidate << threads;
+        EXPECT_EQ(kept.clamped, direct.clamped);
+        EXPECT_GT(kept.clamped, 0u);
+        for (std::size_t s = 0; s < ref.sphere.size(); ++s)
+          EXPECT_EQ(kept.errors[s].relative_rmse, direct.errors[s].relative_rmse);
+      }
+    }
+    AplSet moved = set;
+    moved.levels[2].apls[0].position.x += 1e-3f;
+    EXPECT_THROW(lookups.evaluate(moved, 2, ref, o), std::invalid_argument);
+    AplSet coarser = set;
+    coarser.levels[2] = downsampled_level(set.levels[2], 8);
+    EXPECT_THROW(lookups.evaluate(coarser, 2, ref, o), std::invalid_argument);
+    AplErrorOptions other = o;
+    other.relative_distances = {1, 2};
+    const ReferenceIrradiance other_ref = gather_reference(rays, set.bounds, other);
+    EXPECT_THROW(lookups.evaluate(set, 2, other_ref, o), std::invalid_argument);
   }
 }
 

@@ -37,7 +37,8 @@ lumx::bake::BakeOptions small_bake(std::uint64_t particles) {
   o.volume_voxels = 4096;
   o.bundle.apl.level_counts = {1, 8};
   o.bundle.apl.seed_rays = 20000;
-  // The sanitizer build grades R 32 maps: its fit and kernels run the same code, 64 times cheaper than R 128's.
+  // The sanitizer build grades R 32 maps: its fit and kernels run the same code as at R 128, and this test
+  // takes 62 s there instead of 300 s.
   if (lumx_test::kSanitized) o.bundle.apl.max_resolution = 32;
   return o;
 }

@@ -80,6 +80,7 @@
 #include <lumx/apl/apl_set.h>
 #include <lumx/rays/holdout.h>
 #include <lumx/rays/rayset.h>
+#include <lumx/math/detail/parallel_jobs.h>
 #include <lumx/math/sphere_map.h>
 #include <lumx/math/sphere_map_kernel.h>
 
@@ -92,6 +93,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -109,9 +111,9 @@ struct IrradianceErrors {
   double noise_removed_upper = NAN;
   /// u: the standard error of ε̂² (of ε² − σ², from the reference's noise; header comment).
   double noise_removed_standard_error = NAN;
-  bool resolved = false;       ///< ε̂² > 2u: the error stands out of the reference's noise
-  double l2 = NAN;             ///< l² distance of the normalised distributions (001 §6)
-  double hellinger = NAN;      ///< Hellinger distance of the normalised distributions (001 §6)
+  bool resolved = false;   ///< ε̂² > 2u: the error stands out of the reference's noise
+  double l2 = NAN;         ///< l² distance of the normalised distributions (001 §6)
+  double hellinger = NAN;  ///< Hellinger distance of the normalised distributions (001 §6)
 };
 
 /// Relative RMSE (eq. 5.1), l² and Hellinger distances of `model` against `reference`, patch by patch.
@@ -179,8 +181,7 @@ inline IrradianceErrors compare_irradiance(const std::vector<double>& reference,
 /// over 2 (see the header comment for the factor). NaN when empty or without light; throws
 /// std::invalid_argument when the sizes differ.
 inline double noise_floor(const std::vector<double>& half_a, const std::vector<double>& half_b) {
-  if (half_a.size() != half_b.size())
-    throw std::invalid_argument("noise_floor: the halves have different sizes");
+  if (half_a.size() != half_b.size()) throw std::invalid_argument("noise_floor: the halves have different sizes");
   const std::size_t n = half_a.size();
   if (n == 0) return NAN;
   double sum = 0, sq = 0;
@@ -217,10 +218,15 @@ struct AplErrorOptions {
   /// every sphere is the intensity scaled by 1/ρ².
   double min_diameter = 1e-3;
   std::size_t chunk_rays = 1 << 16;  ///< rays per read
-  /// The level timings repeat the patch loop until at least this long has passed (0: once).
+  /// The level timings repeat the patch loop on one thread until at least this long has passed (0: once,
+  /// and not at all when `threads` is not 1: no time is then reported).
   double min_timing_seconds = 0.01;
-  bool far_field = true;             ///< evaluate the far-field row
-  IrradianceOptions irradiance;      ///< passed to irradiance() (minimum distance)
+  /// Threads a level's points are evaluated on (0: the hardware's, at most 8). Each point is evaluated
+  /// alone, so the errors do not depend on it; the timings are of one thread's loop, as a renderer's shading
+  /// point is one thread's work.
+  unsigned threads = 0;
+  bool far_field = true;         ///< evaluate the far-field row
+  IrradianceOptions irradiance;  ///< passed to irradiance() (minimum distance)
   /// Called with the fraction done (0..1) and a phase ("rays", "levels"), at most a few hundred times.
   std::function<void(double, const char*)> progress;
 };
@@ -231,7 +237,9 @@ class MeasurementSpheres {
   MeasurementSpheres() = default;
   /// Throws std::invalid_argument for bad options (see AplErrorOptions) or a non-finite bound.
   MeasurementSpheres(const BoundingSphere& bounds, const AplErrorOptions& o)
-      : centre_(bounds.center), resolution_(o.patch_resolution), subsamples_(o.patch_subsamples),
+      : centre_(bounds.center),
+        resolution_(o.patch_resolution),
+        subsamples_(o.patch_subsamples),
         rotated_(o.rotated_patches) {
     if (o.relative_distances.empty()) throw std::invalid_argument("apl_error: no relative distance given");
     distances_ = o.relative_distances;
@@ -337,21 +345,21 @@ class MeasurementSpheres {
 
 /// The reference irradiance on one sphere.
 struct SphereReference {
-  double relative_distance = 0;     ///< d
-  double radius = 0;                ///< ρ = d·D, m
-  double patch_area = 0;            ///< 4πρ²/N, m²
-  std::vector<double> irradiance;   ///< E_ref per patch: Σ Φ / A (lx or W/m²)
-  std::vector<double> variance;     ///< v_i: the estimated variance of E_ref(i) ((lx)², header comment)
-  std::vector<double> half_even;    ///< from even-indexed rays only, × 2
-  std::vector<double> half_odd;     ///< from odd-indexed rays only, × 2
-  double flux = 0;                  ///< Σ Φ gathered on this sphere (lm or W)
-  std::uint64_t rays = 0;           ///< rays gathered (flux > 0)
+  double relative_distance = 0;       ///< d
+  double radius = 0;                  ///< ρ = d·D, m
+  double patch_area = 0;              ///< 4πρ²/N, m²
+  std::vector<double> irradiance;     ///< E_ref per patch: Σ Φ / A (lx or W/m²)
+  std::vector<double> variance;       ///< v_i: the estimated variance of E_ref(i) ((lx)², header comment)
+  std::vector<double> half_even;      ///< from even-indexed rays only, × 2
+  std::vector<double> half_odd;       ///< from odd-indexed rays only, × 2
+  double flux = 0;                    ///< Σ Φ gathered on this sphere (lm or W)
+  std::uint64_t rays = 0;             ///< rays gathered (flux > 0)
   std::uint64_t started_outside = 0;  ///< rays (flux > 0) whose start point lies outside this sphere
-  std::uint64_t missed = 0;         ///< of those, rays whose line never leaves the sphere ahead of them
-  double noise_floor = NAN;         ///< σ = √(mean v_i) / mean E_ref: the ε an exact model would show
-  double split_noise_floor = NAN;   ///< noise_floor(half_even, half_odd): the same from the halves' scatter
-  double centring_shift = NAN;      ///< checked_centred_reference: RMS move to the patch centres / mean E_ref
-  double pilot_shape_error = NAN;   ///< checked_centred_reference: upper bound of the pilot's shape error / mean E_ref
+  std::uint64_t missed = 0;           ///< of those, rays whose line never leaves the sphere ahead of them
+  double noise_floor = NAN;           ///< σ = √(mean v_i) / mean E_ref: the ε an exact model would show
+  double split_noise_floor = NAN;     ///< noise_floor(half_even, half_odd): the same from the halves' scatter
+  double centring_shift = NAN;        ///< checked_centred_reference: RMS move to the patch centres / mean E_ref
+  double pilot_shape_error = NAN;  ///< checked_centred_reference: upper bound of the pilot's shape error / mean E_ref
   /// False: E_ref per patch is the patch mean Σ Φ / A. True: moved to the patch centres by a pilot's shape
   /// within each patch (centred_reference), where a level evaluated at one point per patch is queried.
   bool centred = false;
@@ -362,9 +370,9 @@ struct ReferenceIrradiance {
   MeasurementSpheres spheres;
   std::vector<SphereReference> sphere;  ///< one per relative distance, increasing
   PhotometricQuantity quantity = PhotometricQuantity::photometric;
-  std::uint64_t rays = 0;               ///< rays streamed
+  std::uint64_t rays = 0;  ///< rays streamed
   std::uint64_t zero_flux_rays = 0;
-  double flux = 0;                      ///< Σ Φ of every ray (lm or W)
+  double flux = 0;  ///< Σ Φ of every ray (lm or W)
 };
 
 /// Streams `rays` once (rewinding first) and gathers the reference irradiance on the spheres around
@@ -468,22 +476,41 @@ inline ReferenceIrradiance gather_reference(RaySource& rays, const BoundingSpher
 
 /// One row of the evaluation: a level (or the far field) against the reference on every sphere.
 struct LevelErrors {
-  int level = -1;                        ///< index in AplSet::levels; −1 for the far field
-  std::size_t apls = 0;                  ///< APLs evaluated per point
-  int map_resolution = 0;                ///< R of the level's maps
-  int subsamples = 1;                    ///< k: k×k evaluation points per patch
-  std::vector<IrradianceErrors> errors;  ///< one per sphere (increasing d)
+  int level = -1;                               ///< index in AplSet::levels; −1 for the far field
+  std::size_t apls = 0;                         ///< APLs evaluated per point
+  int map_resolution = 0;                       ///< R of the level's maps
+  int subsamples = 1;                           ///< k: k×k evaluation points per patch
+  std::vector<IrradianceErrors> errors;         ///< one per sphere (increasing d)
   std::vector<std::vector<double>> irradiance;  ///< per sphere, the model's E per patch
-  double ns_per_evaluation = NAN;        ///< mean time of one irradiance evaluation (ns)
-  std::size_t bytes = 0;                 ///< AplLevel::map_bytes() (for the far field: level 0's)
-  std::size_t clamped = 0;               ///< APL distances clamped to the minimum (IrradianceResult::clamped)
+  double ns_per_evaluation = NAN;  ///< mean time of one irradiance evaluation on one thread (ns; NaN: untimed)
+  std::size_t bytes = 0;           ///< AplLevel::map_bytes() (for the far field: level 0's)
+  std::size_t clamped = 0;         ///< APL distances clamped to the minimum (IrradianceResult::clamped)
 };
 
 namespace detail {
 
-/// Evaluates `point_irradiance(x, n, clamped)` (a scalar; `clamped` counts clamped distances, null in the
-/// timing repeats) at every evaluation point of every sphere, averages the subsamples per patch, compares,
-/// and times the loop.
+/// The evaluation points of every sphere for k × k points per patch, in float as irradiance() takes them:
+/// point i = s·P + e (P = N·k²) is at the centre + ρ_s·dirs[e], with normal −dirs[e] (facing the centre).
+struct EvaluationPoints {
+  std::vector<glm::vec3> x, normal;  ///< per point; per direction e
+  std::size_t per_sphere = 0;        ///< P
+  EvaluationPoints(const MeasurementSpheres& ms, int k) {
+    const std::vector<glm::dvec3> dirs = ms.evaluation_directions(k);
+    per_sphere = dirs.size();
+    x.resize(ms.sphere_count() * dirs.size());
+    normal.resize(dirs.size());
+    for (std::size_t e = 0; e < dirs.size(); ++e) normal[e] = glm::vec3(-dirs[e]);
+    for (std::size_t s = 0; s < ms.sphere_count(); ++s)
+      for (std::size_t e = 0; e < dirs.size(); ++e)
+        x[s * dirs.size() + e] = glm::vec3(ms.centre() + ms.radius(s) * dirs[e]);
+  }
+  const glm::vec3& normal_of(std::size_t i) const { return normal[i % per_sphere]; }
+};
+
+/// Evaluates `point_irradiance(i, x, n, clamped)` (a scalar at point i, x, with normal n; `clamped` counts
+/// clamped distances, null in the timing repeats; called from several threads at once unless o.threads is
+/// 1) at every evaluation point of every sphere (EvaluationPoints), averages the subsamples per patch,
+/// compares, and times the loop on one thread.
 template <class PointIrradiance>
 void evaluate_rows(const ReferenceIrradiance& ref, const AplErrorOptions& o, LevelErrors& row,
                    PointIrradiance&& point_irradiance) {
@@ -491,36 +518,45 @@ void evaluate_rows(const ReferenceIrradiance& ref, const AplErrorOptions& o, Lev
   const std::size_t ns = ms.sphere_count(), np = ms.patch_count();
   row.subsamples = ms.subsamples_for(row.map_resolution, row.apls);
   const std::size_t k2 = std::size_t(row.subsamples) * std::size_t(row.subsamples);
-  const std::vector<glm::dvec3> dirs = ms.evaluation_directions(row.subsamples);
-  // Points and normals in float, as irradiance() takes them, computed before the clock starts.
-  std::vector<glm::vec3> xs(ns * dirs.size()), normals(dirs.size());
-  for (std::size_t e = 0; e < dirs.size(); ++e) normals[e] = glm::vec3(-dirs[e]);
-  for (std::size_t s = 0; s < ns; ++s)
-    for (std::size_t e = 0; e < dirs.size(); ++e) xs[s * dirs.size() + e] = glm::vec3(ms.centre() + ms.radius(s) * dirs[e]);
+  // Computed before the clock starts.
+  const EvaluationPoints points(ms, row.subsamples);
+  const std::vector<glm::vec3>& xs = points.x;
   std::vector<double> values(xs.size());
   using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
-  std::size_t clamped = 0;
-  for (std::size_t i = 0; i < xs.size(); ++i) values[i] = point_irradiance(xs[i], normals[i % dirs.size()], &clamped);
-  double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  std::size_t passes = 1;
+  double seconds = 0;
+  std::size_t passes = 0, clamped = 0;
+  if (o.threads == 1) {
+    const auto t0 = Clock::now();
+    for (std::size_t i = 0; i < xs.size(); ++i) values[i] = point_irradiance(i, xs[i], points.normal_of(i), &clamped);
+    seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    passes = 1;
+  } else {
+    // Contiguous ranges of points, each with its own count of clamped distances.
+    const std::size_t jobs = std::min<std::size_t>(xs.size(), 64);
+    std::vector<std::size_t> clamped_in(jobs, 0);
+    parallel_jobs(jobs, o.threads, [&](std::size_t j) {
+      for (std::size_t i = xs.size() * j / jobs; i < xs.size() * (j + 1) / jobs; ++i)
+        values[i] = point_irradiance(i, xs[i], points.normal_of(i), &clamped_in[j]);
+    });
+    for (std::size_t c : clamped_in) clamped += c;
+  }
   volatile double sink = 0;
   while (seconds < o.min_timing_seconds && passes < 100000 && !xs.empty()) {
     const auto t1 = Clock::now();
     double s = 0;
-    for (std::size_t i = 0; i < xs.size(); ++i) s += point_irradiance(xs[i], normals[i % dirs.size()], nullptr);
+    for (std::size_t i = 0; i < xs.size(); ++i) s += point_irradiance(i, xs[i], points.normal_of(i), nullptr);
     sink = sink + s;
     seconds += std::chrono::duration<double>(Clock::now() - t1).count();
     ++passes;
   }
   row.clamped = clamped;
-  row.ns_per_evaluation = xs.empty() ? NAN : 1e9 * seconds / (double(passes) * double(xs.size()));
+  row.ns_per_evaluation = xs.empty() || passes == 0 ? NAN : 1e9 * seconds / (double(passes) * double(xs.size()));
   row.irradiance.assign(ns, std::vector<double>(np, 0.0));
   row.errors.resize(ns);
   for (std::size_t s = 0; s < ns; ++s) {
     for (std::size_t p = 0; p < np; ++p) {
       double sum = 0;
-      for (std::size_t j = 0; j < k2; ++j) sum += values[s * dirs.size() + p * k2 + j];
+      for (std::size_t j = 0; j < k2; ++j) sum += values[s * points.per_sphere + p * k2 + j];
       row.irradiance[s][p] = sum / double(k2);
     }
     row.errors[s] = compare_irradiance(ref.sphere[s].irradiance, row.irradiance[s], ref.sphere[s].variance);
@@ -539,13 +575,165 @@ inline LevelErrors evaluate_level(const AplSet& set, std::size_t k, const Refere
   row.apls = level.size();
   row.map_resolution = level.map_resolution;
   row.bytes = level.map_bytes();
-  detail::evaluate_rows(ref, options, row, [&](const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
-    const IrradianceResult r = irradiance(set, k, x, n, options.irradiance);
-    if (clamped) *clamped += r.clamped;
-    return luminance_of(set.channels, r.irradiance);
-  });
+  detail::evaluate_rows(ref, options, row,
+                        [&](std::size_t, const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
+                          const IrradianceResult r = irradiance(set, k, x, n, options.irradiance);
+                          if (clamped) *clamped += r.clamped;
+                          return luminance_of(set.channels, r.irradiance);
+                        });
   return row;
 }
+
+namespace detail {
+/// Everything irradiance() computes for a level at the evaluation points of a reference before it reads a
+/// texel (apl_lookup: which APLs light each point, their footprints as offsets into the maps, their
+/// weights), kept so that levels differing from it only in their maps' values (the fit's candidates at
+/// one resolution: one level's maps downsampled, then smoothed in turn) are evaluated by the blends
+/// alone, to the same bits as evaluate_level. Memory: 20 bytes per point and APL (the fit's 12 288 points,
+/// R 32 patches on six spheres, × 512 APLs: 126 MB).
+class LevelLookups {
+ public:
+  /// The bytes LevelLookups(set, k, ref, o) would hold.
+  static double bytes_for(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref) {
+    const AplLevel& level = set.levels.at(k);
+    const double q = double(ref.spheres.subsamples_for(level.map_resolution, level.size()));
+    return double(sizeof(Entry)) * double(level.size()) * double(ref.spheres.sphere_count()) *
+           double(ref.spheres.patch_count()) * q * q;
+  }
+
+  /// The lookups of level k of `set` at the evaluation points of `ref`, on o.threads threads.
+  LevelLookups(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref, const AplErrorOptions& o) {
+    const AplLevel& level = set.levels.at(k);
+    apls_ = level.size();
+    resolution_ = level.map_resolution;
+    to_map_ = level.frame.to_map;
+    for (const Apl& a : level.apls) {
+      positions_.push_back(a.position);
+      channels_.push_back(a.map.channels());
+    }
+    subsamples_ = ref.spheres.subsamples_for(level.map_resolution, apls_);
+    const EvaluationPoints points(ref.spheres, subsamples_);
+    const std::size_t n = points.x.size();
+    points_ = points.x;
+    entries_.resize(n * apls_);
+    count_.assign(n, 0);
+    clamped_.assign(n, 0);
+    const float min_r = float(effective_min_distance(set, o.irradiance));
+    const glm::mat3 to_map = level.frame.to_map;
+    const glm::mat3* turn = level.frame.is_identity() ? nullptr : &to_map;
+    const std::size_t jobs = std::min<std::size_t>(n, 64);
+    parallel_jobs(jobs, o.threads, [&](std::size_t j) {
+      for (std::size_t i = n * j / jobs; i < n * (j + 1) / jobs; ++i) {
+        Entry* out = entries_.data() + i * apls_;
+        std::size_t count = 0, clamped = 0;
+        for (std::size_t a = 0; a < apls_; ++a) {
+          SphereMap::Footprint f;
+          float weight;
+          if (!apl_lookup(level.apls[a], points.x[i], points.normal_of(i), min_r, o.irradiance.ignore_normal, turn, f,
+                          weight, clamped))
+            continue;
+          Entry& e = out[count++];
+          e.apl = std::uint32_t(a);
+          // A footprint inside the square: texel (x0, y0) of the map and its right and lower neighbours;
+          // across a seam (the squares' edges, whose neighbours are elsewhere) it is taken again.
+          const float* p = f.texel[0];
+          const std::ptrdiff_t C = level.apls[a].map.channels(), row = std::ptrdiff_t(level.apls[a].map.width()) * C;
+          const bool inside = f.texel[1] - p == C && f.texel[2] - p == row && f.texel[3] - p == row + C;
+          e.texel = inside ? std::uint32_t(p - level.apls[a].map.data()) : kSeam;
+          e.tx = f.tx;
+          e.ty = f.ty;
+          e.weight = weight;
+        }
+        count_[i] = std::uint32_t(count);
+        clamped_[i] = std::uint32_t(clamped);
+      }
+    });
+  }
+
+  /// Level k of `set` against `ref` (as evaluate_level, the same bits). Throws std::invalid_argument when
+  /// the level is not laid out as the one the lookups were taken from (its APLs, their positions, maps'
+  /// resolutions and channels, or its frame) or `ref` has other evaluation points.
+  LevelErrors evaluate(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref,
+                       const AplErrorOptions& o) const {
+    const AplLevel& level = set.levels.at(k);
+    check(level, ref);
+    LevelErrors row;
+    row.level = int(k);
+    row.apls = level.size();
+    row.map_resolution = level.map_resolution;
+    row.bytes = level.map_bytes();
+    evaluate_rows(ref, o, row, [&](std::size_t i, const glm::vec3&, const glm::vec3&, std::size_t* clamped) {
+      if (clamped) *clamped += clamped_[i];
+      return luminance_of(set.channels, glm::dvec3(sum_at(level, i)));
+    });
+    return row;
+  }
+
+ private:
+  static constexpr std::uint32_t kSeam = 0xffffffffu;
+  struct Entry {
+    std::uint32_t apl;
+    std::uint32_t texel;  ///< offset of SphereMap::Footprint::texel[0] in the map's values; kSeam: across a seam
+    float tx, ty, weight;
+  };
+  // The level's layout: what the lookups depend on besides the maps' values.
+  std::size_t apls_ = 0;
+  int resolution_ = 0;
+  glm::mat3 to_map_{1.0f};
+  std::vector<glm::vec3> positions_;
+  std::vector<int> channels_;
+  std::vector<glm::vec3> points_;  ///< the evaluation points they were taken at
+  int subsamples_ = 1;
+  std::vector<Entry> entries_;  ///< point i's at [i·apls, i·apls + count_[i])
+  std::vector<std::uint32_t> count_, clamped_;
+
+  void check(const AplLevel& level, const ReferenceIrradiance& ref) const {
+    bool same = level.size() == apls_ && level.map_resolution == resolution_ && level.frame.to_map == to_map_ &&
+                ref.spheres.subsamples_for(level.map_resolution, apls_) == subsamples_ &&
+                EvaluationPoints(ref.spheres, subsamples_).x == points_;
+    for (std::size_t a = 0; same && a < apls_; ++a)
+      same = level.apls[a].position == positions_[a] && level.apls[a].map.resolution() == resolution_ &&
+             level.apls[a].map.channels() == channels_[a];
+    if (!same)
+      throw std::invalid_argument("LevelLookups: the level or the reference is not the one they were taken for");
+  }
+
+  /// irradiance()'s sum at point i: the blends in APL order, their texels prefetched 32 APLs ahead.
+  glm::vec3 sum_at(const AplLevel& level, std::size_t i) const {
+    const glm::mat3 to_map = level.frame.to_map;
+    const bool turned = !level.frame.is_identity();
+    constexpr std::size_t kChunk = 32;
+    const Entry* e = entries_.data() + i * apls_;
+    const std::size_t n = count_[i];
+    glm::vec3 sum(0.0f);
+    SphereMap::Footprint f[kChunk];
+    for (std::size_t begin = 0; begin < n; begin += kChunk) {
+      const std::size_t end = std::min(n, begin + kChunk);
+      for (std::size_t j = begin; j < end; ++j) {
+        const SphereMap& map = level.apls[e[j].apl].map;
+        SphereMap::Footprint& fj = f[j - begin];
+        if (e[j].texel != kSeam) {
+          const float* p = map.data() + e[j].texel;
+          const std::ptrdiff_t C = map.channels(), row = std::ptrdiff_t(map.width()) * C;
+          fj.texel[0] = p;
+          fj.texel[1] = p + C;
+          fj.texel[2] = p + row;
+          fj.texel[3] = p + row + C;
+          fj.tx = e[j].tx;
+          fj.ty = e[j].ty;
+        } else {
+          float r, r2;
+          const glm::vec3 w = apl_direction(positions_[e[j].apl], points_[i], r, r2);
+          fj = map.footprint(turned ? to_map * w : w);
+        }
+        for (const float* t : fj.texel) __builtin_prefetch(t);
+      }
+      for (std::size_t j = begin; j < end; ++j) sum += level.apls[e[j].apl].map.blend(f[j - begin]) * e[j].weight;
+    }
+    return sum;
+  }
+};
+}  // namespace detail
 
 /// Irradiance at x (normal n) from level 0's far-field intensity Σ_i I_i(ω) placed at the bounding-sphere
 /// centre (the "far field" row; see the header comment). Throws std::out_of_range without levels.
@@ -575,7 +763,7 @@ inline LevelErrors evaluate_far_field(const AplSet& set, const ReferenceIrradian
   row.apls = 1;
   row.map_resolution = level.map_resolution;
   row.bytes = level.map_bytes();
-  detail::evaluate_rows(ref, options, row, [&](const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
+  detail::evaluate_rows(ref, options, row, [&](std::size_t, const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
     return far_field_irradiance(set, x, n, options.irradiance, clamped);
   });
   return row;
@@ -728,26 +916,6 @@ inline int fit_patch_resolution(int patch_resolution, std::uint64_t rays) {
   return R;
 }
 
-namespace detail {
-/// body(i) for i in [0, n), split into contiguous ranges over up to `threads` threads (0: the hardware's,
-/// at most 8; one per 8 items at least), for work whose items are independent.
-template <class Body>
-void for_each_map(std::size_t n, unsigned threads, Body&& body) {
-  if (threads == 0) threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
-  threads = unsigned(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 8)));
-  const auto run = [&](std::size_t from, std::size_t to) {
-    for (std::size_t i = from; i < to; ++i) body(i);
-  };
-  if (threads <= 1) {
-    run(0, n);
-    return;
-  }
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(run, n * t / threads, n * (t + 1) / threads);
-  for (std::thread& t : pool) t.join();
-}
-}  // namespace detail
-
 /// The level's maps box-downsampled to resolution R (a power-of-two fraction of theirs; else throws).
 inline AplLevel downsampled_level(const AplLevel& level, int R) {
   AplLevel out = level;
@@ -769,13 +937,18 @@ inline SphereMap level_sum(const AplLevel& level) {
   return total;
 }
 
+/// Maps per thread at least when a level's maps are smoothed in parallel, so that a level of a few APLs
+/// is not split over threads that cost more to start than its maps do to smooth.
+inline constexpr std::size_t kMapsPerThread = 8;
+
 /// K·f of every map of `level` (`kernel`'s resolution), on up to `threads` threads (0: the hardware's): what
 /// every mode of one kernel starts from (SphereMapKernel::with_gain). Each map is smoothed alone, so the
 /// result does not depend on the thread count.
 inline std::vector<SphereMap> kernel_applied_maps(const AplLevel& level, const SphereMapKernel& kernel,
                                                   unsigned threads = 0) {
   std::vector<SphereMap> out(level.apls.size());
-  detail::for_each_map(out.size(), threads, [&](std::size_t i) { out[i] = kernel.apply(level.apls[i].map); });
+  detail::parallel_jobs(
+      out.size(), threads, [&](std::size_t i) { out[i] = kernel.apply(level.apls[i].map); }, kMapsPerThread);
   return out;
 }
 
@@ -788,11 +961,26 @@ inline AplLevel level_from_applied(const AplLevel& level, std::vector<SphereMap>
   if (applied.size() != level.apls.size())
     throw std::invalid_argument("level_from_applied: " + std::to_string(applied.size()) + " smoothed maps for " +
                                 std::to_string(level.apls.size()) + " APLs");
-  AplLevel out = level;
+  // Every field but the maps, which are written below (copying the input's maps first would cost a
+  // level's map bytes, 64 MB at R 128 × 512 APLs, per candidate).
+  AplLevel out;
+  out.map_resolution = level.map_resolution;
+  out.frame = level.frame;
+  out.error = level.error;
+  out.apls.resize(level.apls.size());
+  for (std::size_t i = 0; i < level.apls.size(); ++i) {
+    out.apls[i].position = level.apls[i].position;
+    out.apls[i].flux = level.apls[i].flux;
+    out.apls[i].parent = level.apls[i].parent;
+  }
   const bool with_gain = mode != KernelMode::plain;
-  detail::for_each_map(out.apls.size(), threads, [&](std::size_t i) {
-    out.apls[i].map = with_gain ? kernel.with_gain(level.apls[i].map, std::move(applied[i]), gain) : std::move(applied[i]);
-  });
+  detail::parallel_jobs(
+      out.apls.size(), threads,
+      [&](std::size_t i) {
+        out.apls[i].map =
+            with_gain ? kernel.with_gain(level.apls[i].map, std::move(applied[i]), gain) : std::move(applied[i]);
+      },
+      kMapsPerThread);
   return out;
 }
 
@@ -965,6 +1153,11 @@ inline constexpr double kParsimonyBytes = 1024.0 * 1024.0;
 /// 914 → 1 046 MB peak resident; with three, 37.1 s and 1 111 MB).
 inline constexpr double kAppliedBytes = 128.0 * 1024.0 * 1024.0;
 
+/// The memory fit_map_resolutions may keep the lookups of one level at one resolution in
+/// (detail::LevelLookups), so that its candidates there are graded by their blends alone: 128 MiB, a
+/// 512-APL level at the 12 288 points of R 32 patches (the fit's for up to 10⁶ rays: fit_patch_resolution).
+inline constexpr double kLookupBytes = 128.0 * 1024.0 * 1024.0;
+
 /// The error beyond which the kernel guard of fit_map_resolutions does not protect a distance (relative RMSE).
 inline constexpr double kUnusableError = 0.25;
 
@@ -1000,8 +1193,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       eligible.push_back({tried.back(), std::move(last_values), std::move(gain)});
       if (tried.back().cost < best.cost) best = tried.back(), best_at = eligible.size() - 1;
     };
+    // The lookups of the level at the current R: every candidate there has its layout (kLookupBytes).
+    std::optional<detail::LevelLookups> lookups;
     const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
-      LevelErrors row = evaluate_level(set, k, ref, o);
+      LevelErrors row = lookups ? lookups->evaluate(set, k, ref, o) : evaluate_level(set, k, ref, o);
       last_values = std::move(row.irradiance);
       errors.clear();
       for (const IrradianceErrors& e : row.errors) errors.push_back(e.relative_rmse);
@@ -1021,6 +1216,8 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       const AplLevel at_r = downsampled_level(built, R);
       const SphereMap sum_at_r = level_sum(at_r);
       set.levels[k] = at_r;
+      lookups.reset();
+      if (detail::LevelLookups::bytes_for(set, k, ref) <= kLookupBytes) lookups.emplace(set, k, ref, o);
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       admit(SphereMap());
       // The cost of the last two-scale candidate admitted at this R, and whether a wider one may still win.
@@ -1136,7 +1333,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       best_at = simpler;
     }
     set.levels[k] = downsampled_level(built, best.resolution);
-    // Smoothed with the gain the candidate was graded with (the level sum's at that resolution).
+    // Smoothed with the gain the candidate was graded with (the level sum's at that resolution). Smoothed
+    // again rather than kept from its grading: keeping the best candidate so far would hold one more
+    // level's maps (64 MB at R 128 × 512 APLs) to save one smoothing, where grading smoothed once per
+    // kernel width tried.
     if (best.kappa > 0)
       set.levels[k] = smoothed_level_with_gain(set.levels[k], *kernel_for(best.resolution, best.kappa), best.mode,
                                                eligible.at(best_at).gain);

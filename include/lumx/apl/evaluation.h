@@ -42,14 +42,43 @@ struct IrradianceOptions {
 };
 
 struct IrradianceResult {
-  glm::dvec3 irradiance{0.0};   ///< lx or W/m² per channel
-  std::size_t clamped = 0;      ///< APLs closer than min_distance (their r was clamped)
+  glm::dvec3 irradiance{0.0};  ///< lx or W/m² per channel
+  std::size_t clamped = 0;     ///< APLs closer than min_distance (their r was clamped)
 };
 
 namespace detail {
 inline double effective_min_distance(const AplSet& set, const IrradianceOptions& o) {
   if (o.min_distance > 0) return o.min_distance;
   return set.bounds.radius > 0 ? 2e-6 * set.bounds.radius : 1e-9;
+}
+
+/// The unit direction w from an APL at p to x, with r = |x − p| and r2 = r² (at the APL itself w is
+/// arbitrary but fixed).
+inline glm::vec3 apl_direction(const glm::vec3& p, const glm::vec3& x, float& r, float& r2) {
+  const glm::vec3 d = x - p;
+  r2 = glm::dot(d, d);
+  r = std::sqrt(r2);
+  return r > 0 ? d * (1.0f / r) : glm::vec3(0, 0, -1);
+}
+
+/// What irradiance() reads of one APL for a point x with normal n, before any texel: the direction w
+/// (apl_direction), r clamped to `min_r` (counted in `clamped`), and, where the receiver faces the APL
+/// (cos = −n·w > 0, or ignore_normal), the map's bilinear footprint at w (turned into the map's frame
+/// when `to_map` is given) and the weight cos/r². Returns false where the APL does not light x; its
+/// contribution is then blend(footprint) × weight × visibility.
+inline bool apl_lookup(const Apl& a, const glm::vec3& x, const glm::vec3& n, float min_r, bool ignore_normal,
+                       const glm::mat3* to_map, SphereMap::Footprint& footprint, float& weight, std::size_t& clamped) {
+  float r, r2;
+  const glm::vec3 w = apl_direction(a.position, x, r, r2);
+  if (r < min_r) {
+    r2 = min_r * min_r;
+    ++clamped;
+  }
+  const float cosine = ignore_normal ? 1.0f : -glm::dot(n, w);
+  if (cosine <= 0.0f) return false;
+  footprint = a.map.footprint(to_map ? *to_map * w : w);
+  weight = cosine / r2;
+  return true;
 }
 }  // namespace detail
 
@@ -77,22 +106,14 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
     std::size_t count = 0;
     for (std::size_t i = begin; i < end; ++i) {
       const Apl& a = level.apls[i];
-      const glm::vec3 d = x - a.position;
-      float r2 = glm::dot(d, d);
-      float r = std::sqrt(r2);
-      // At the APL itself the direction is arbitrary but fixed.
-      const glm::vec3 w = r > 0 ? d * (1.0f / r) : glm::vec3(0, 0, -1);
-      if (r < min_r) {
-        r2 = min_r * min_r;
-        ++result.clamped;
-      }
-      const float cosine = options.ignore_normal ? 1.0f : -glm::dot(n, w);
-      if (cosine <= 0.0f) continue;
+      float weight;
+      if (!detail::apl_lookup(a, x, n, min_r, options.ignore_normal, turned ? &to_map : nullptr, footprints[count],
+                              weight, result.clamped))
+        continue;
       const float v = visibility(i, a.position, x);
       if (v <= 0.0f) continue;
-      footprints[count] = a.map.footprint(turned ? to_map * w : w);
       for (const float* t : footprints[count].texel) __builtin_prefetch(t);
-      weights[count] = cosine * v / r2;
+      weights[count] = weight * v;
       index[count] = i;
       ++count;
     }
@@ -103,8 +124,8 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
 }
 
 /// Irradiance without occluders.
-inline IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const glm::vec3& x,
-                                   const glm::vec3& n, const IrradianceOptions& options = {}) {
+inline IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const glm::vec3& x, const glm::vec3& n,
+                                   const IrradianceOptions& options = {}) {
   return irradiance(
       set, level_index, x, n, [](std::size_t, const glm::vec3&, const glm::vec3&) { return 1.0f; }, options);
 }

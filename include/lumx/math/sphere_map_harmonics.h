@@ -32,6 +32,7 @@
 #pragma once
 
 #include <lumx/math/constants.h>
+#include <lumx/math/detail/parallel_jobs.h>
 #include <lumx/math/sphere_map.h>
 #include <lumx/version.h>
 
@@ -43,7 +44,6 @@
 #include <deque>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 LUMX_NAMESPACE_BEGIN
@@ -102,7 +102,7 @@ class SphereMapHarmonics {
     const std::size_t pairs = R * R;  // texel (x, y) of the upper square and its mirror (x + R, y)
     const int C = map.channels();
     std::vector<std::vector<double>> part(chunks);
-    parallel(chunks, threads, [&](std::size_t chunk) {
+    detail::parallel_jobs(chunks, threads, [&](std::size_t chunk) {
       std::vector<double>& c = part[chunk];
       c.assign(nc, 0.0);
       std::vector<double> y(nc);
@@ -133,7 +133,7 @@ class SphereMapHarmonics {
     const double omega = out.texel_solid_angle();
     const std::size_t chunks = 32, nc = coefficient_count(), R = std::size_t(resolution_), W = 2 * R;
     const std::size_t pairs = R * R;
-    parallel(chunks, threads, [&](std::size_t chunk) {
+    detail::parallel_jobs(chunks, threads, [&](std::size_t chunk) {
       std::vector<double> y(nc);
       for (std::size_t i = pairs * chunk / chunks; i < pairs * (chunk + 1) / chunks; ++i) {
         const std::size_t up = (i / R) * W + i % R, down = up + R;
@@ -194,22 +194,6 @@ class SphereMapHarmonics {
     if (map.resolution() != resolution_)
       throw std::invalid_argument("SphereMapHarmonics: a map of resolution " + std::to_string(map.resolution()) +
                                   " for an expansion at " + std::to_string(resolution_));
-  }
-
-  template <class F>
-  static void parallel(std::size_t jobs, unsigned threads, F&& job) {
-    if (threads == 0) threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
-    threads = unsigned(std::min<std::size_t>(threads, jobs));
-    if (threads <= 1) {
-      for (std::size_t j = 0; j < jobs; ++j) job(j);
-      return;
-    }
-    std::vector<std::thread> pool;
-    for (unsigned t = 0; t < threads; ++t)
-      pool.emplace_back([&, t] {
-        for (std::size_t j = t; j < jobs; j += threads) job(j);
-      });
-    for (std::thread& t : pool) t.join();
   }
 };
 

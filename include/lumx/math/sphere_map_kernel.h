@@ -353,16 +353,14 @@ class SphereMapKernel {
   /// nonnegative correction, where twicing each sparse map alone would clamp the negative rings of its
   /// isolated rays and flatten the very lobe it is meant to keep.
   SphereMap apply_with_gain(const SphereMap& in, const SphereMap& gain) const {
-    if (gain.resolution() != resolution_ || gain.channels() != 1)
-      throw std::invalid_argument("SphereMapKernel: the gain must be one channel at the kernel's resolution");
+    check_gain(gain);  // before the smoothing it would waste
     return with_gain(in, apply(in), gain);
   }
 
   /// apply_with_gain(in, gain) from `smoothed` = apply(in), to the same bits: every mode of one kernel starts
   /// from K·f, so a caller trying several modes (the held-out fit) smooths each map once.
   SphereMap with_gain(const SphereMap& in, SphereMap smoothed, const SphereMap& gain) const {
-    if (gain.resolution() != resolution_ || gain.channels() != 1)
-      throw std::invalid_argument("SphereMapKernel: the gain must be one channel at the kernel's resolution");
+    check_gain(gain);
     if (smoothed.resolution() != in.resolution() || smoothed.channels() != in.channels() || in.resolution() != resolution_)
       throw std::invalid_argument("SphereMapKernel: the smoothed map must be the input's, at the kernel's resolution");
     SphereMap out = std::move(smoothed);
@@ -464,6 +462,11 @@ class SphereMapKernel {
 
 
  private:
+  void check_gain(const SphereMap& gain) const {
+    if (gain.resolution() != resolution_ || gain.channels() != 1)
+      throw std::invalid_argument("SphereMapKernel: the gain must be one channel at the kernel's resolution");
+  }
+
   int resolution_ = 0;
   double kappa_ = 0;
   std::vector<glm::dvec3> centres_;  ///< texel centres (unit directions)
