@@ -314,7 +314,7 @@ TEST(AplErrorLevels, ErrorDecreasesWithLevelNearAndAgreesFarAway) {
   ASSERT_EQ(set.levels.size(), 4u);
   AplErrorOptions o;
   o.min_timing_seconds = 0;
-  o.threads = 1;  // timed: the untimed points run on one thread
+  o.threads = 1;  // the points on one thread: that pass is timed
   const AplErrorReport r = evaluate_apl_errors(set, rays, o);
   ASSERT_EQ(r.levels.size(), 4u);
   const auto& spheres = r.reference.sphere;
@@ -484,8 +484,8 @@ TEST(AplErrorLevels, DeterministicWhateverTheChunkSizeAndThreadCount) {
 }
 
 // The fit grades every candidate at one resolution through the lookups of the first: the same bits as
-// evaluate_level, for maps of other values, in a turned frame, with clamped distances; another layout or
-// another reference is refused.
+// evaluate_level, for maps of other values, in a turned frame, with clamped distances; another layout,
+// other irradiance options or another reference are refused.
 TEST(AplErrorLevels, LookupsKeptForALayoutGiveEvaluateLevelsBits) {
   MemoryRaySource rays = ring_rays(60000, 23);
   AplSet set = build_fixed(rays, 16, {1, 8, 64});
@@ -518,6 +518,11 @@ TEST(AplErrorLevels, LookupsKeptForALayoutGiveEvaluateLevelsBits) {
     AplSet coarser = set;
     coarser.levels[2] = downsampled_level(set.levels[2], 8);
     EXPECT_THROW(lookups.evaluate(coarser, 2, ref, o), std::invalid_argument);
+    AplErrorOptions closer = o, facing = o;
+    closer.irradiance.min_distance *= 0.5;
+    facing.irradiance.ignore_normal = true;
+    EXPECT_THROW(lookups.evaluate(set, 2, ref, closer), std::invalid_argument);
+    EXPECT_THROW(lookups.evaluate(set, 2, ref, facing), std::invalid_argument);
     AplErrorOptions other = o;
     other.relative_distances = {1, 2};
     const ReferenceIrradiance other_ref = gather_reference(rays, set.bounds, other);

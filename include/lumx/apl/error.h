@@ -66,14 +66,16 @@
 // has √2 × the noise and a difference of two halves √2 × more): a second estimate of σ, from the rays'
 // scatter rather than a formula; the tests check that the two agree.
 //
-// Cost. Each level's irradiance over every point of every sphere is timed with std::chrono (repeated
-// until `min_timing_seconds` have passed) and reported as ns per irradiance evaluation, beside the bytes
-// of its maps (AplLevel::map_bytes()).
+// Cost. A level's points are evaluated on `threads` threads; its irradiance is timed with std::chrono on
+// one thread (the whole pass when it runs on one thread, then points spread over every sphere until
+// `min_timing_seconds` have passed; none when the option is 0 and the pass ran on several) and reported
+// as ns per irradiance evaluation, beside the bytes of its maps (AplLevel::map_bytes()).
 //
 // Determinism and memory. The rays are streamed once, in order, and summed in double: the same set,
-// rays and options give bit-identical errors (timings aside), whatever the chunk size. Memory is
-// O(spheres × N) for the reference and O(spheres × N × k²) while a level is evaluated, independent of the
-// ray count.
+// rays and options give bit-identical errors (timings aside), whatever the chunk size and thread count.
+// Memory is O(spheres × N) for the reference and O(spheres × N × k²) while a level is evaluated,
+// independent of the ray count; the fit also keeps a level's lookups, O(spheres × N × APLs), up to
+// kLookupBytes.
 #pragma once
 
 #include <lumx/apl/evaluation.h>
@@ -91,8 +93,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -211,15 +215,15 @@ struct AplErrorOptions {
   /// level at R 16 is graded ~2× better than at a renderer's random shading points (docs/apl_sets.md).
   bool rotated_patches = true;
   /// Bound on one level's APL lookups (APLs × k² × N × spheres) when k is automatic (2·10⁸: 5–10 s at
-  /// 25–50 ns per lookup).
+  /// 25–50 ns per lookup on one thread).
   double max_apl_lookups = 2e8;
   /// D used when the set's bounding diameter is smaller (m). A point source (every ray from one point,
   /// D = 0) still gets spheres; its relative errors do not depend on the radius, since its pattern on
   /// every sphere is the intensity scaled by 1/ρ².
   double min_diameter = 1e-3;
   std::size_t chunk_rays = 1 << 16;  ///< rays per read
-  /// The level timings repeat the patch loop on one thread until at least this long has passed (0: once,
-  /// and not at all when `threads` is not 1: no time is then reported).
+  /// The level timings run on one thread until at least this long has passed (0: the one-thread pass
+  /// only, and none when the points ran on several threads: no time is then reported).
   double min_timing_seconds = 0.01;
   /// Threads a level's points are evaluated on (0: the hardware's, at most 8). Each point is evaluated
   /// alone, so the errors do not depend on it; the timings are of one thread's loop, as a renderer's shading
@@ -524,12 +528,12 @@ void evaluate_rows(const ReferenceIrradiance& ref, const AplErrorOptions& o, Lev
   std::vector<double> values(xs.size());
   using Clock = std::chrono::steady_clock;
   double seconds = 0;
-  std::size_t passes = 0, clamped = 0;
-  if (o.threads == 1) {
+  std::size_t timed = 0, clamped = 0;  // point evaluations timed; clamped distances
+  if (parallel_threads(xs.size(), o.threads) == 1) {
     const auto t0 = Clock::now();
     for (std::size_t i = 0; i < xs.size(); ++i) values[i] = point_irradiance(i, xs[i], points.normal_of(i), &clamped);
     seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    passes = 1;
+    timed = xs.size();
   } else {
     // Contiguous ranges of points, each with its own count of clamped distances.
     const std::size_t jobs = std::min<std::size_t>(xs.size(), 64);
@@ -540,17 +544,24 @@ void evaluate_rows(const ReferenceIrradiance& ref, const AplErrorOptions& o, Lev
     });
     for (std::size_t c : clamped_in) clamped += c;
   }
+  // Timed (further) on one thread until min_timing_seconds have passed: batches of 64 points taken with a
+  // stride prime to their count, so that every sphere is sampled whatever the batches' number.
+  const std::size_t n = xs.size();
+  std::size_t stride = n > 0 ? 7919 % n : 1;
+  if (n > 0 && std::gcd(stride, n) != 1) stride = 1;
+  std::size_t next = 0;
   volatile double sink = 0;
-  while (seconds < o.min_timing_seconds && passes < 100000 && !xs.empty()) {
+  while (seconds < o.min_timing_seconds && n > 0 && timed < 100000 * n) {
     const auto t1 = Clock::now();
     double s = 0;
-    for (std::size_t i = 0; i < xs.size(); ++i) s += point_irradiance(i, xs[i], points.normal_of(i), nullptr);
+    for (int b = 0; b < 64; ++b, next = (next + stride) % n)
+      s += point_irradiance(next, xs[next], points.normal_of(next), nullptr);
     sink = sink + s;
     seconds += std::chrono::duration<double>(Clock::now() - t1).count();
-    ++passes;
+    timed += 64;
   }
   row.clamped = clamped;
-  row.ns_per_evaluation = xs.empty() || passes == 0 ? NAN : 1e9 * seconds / (double(passes) * double(xs.size()));
+  row.ns_per_evaluation = timed == 0 ? NAN : 1e9 * seconds / double(timed);
   row.irradiance.assign(ns, std::vector<double>(np, 0.0));
   row.errors.resize(ns);
   for (std::size_t s = 0; s < ns; ++s) {
@@ -586,7 +597,7 @@ inline LevelErrors evaluate_level(const AplSet& set, std::size_t k, const Refere
 
 namespace detail {
 /// Everything irradiance() computes for a level at the evaluation points of a reference before it reads a
-/// texel (apl_lookup: which APLs light each point, their footprints as offsets into the maps, their
+/// texel (apl_geometry: which APLs light each point, their footprints as offsets into the maps, their
 /// weights), kept so that levels differing from it only in their maps' values (the fit's candidates at
 /// one resolution: one level's maps downsampled, then smoothed in turn) are evaluated by the blends
 /// alone, to the same bits as evaluate_level. Memory: 20 bytes per point and APL (the fit's 12 288 points,
@@ -597,8 +608,8 @@ class LevelLookups {
   static double bytes_for(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref) {
     const AplLevel& level = set.levels.at(k);
     const double q = double(ref.spheres.subsamples_for(level.map_resolution, level.size()));
-    return double(sizeof(Entry)) * double(level.size()) * double(ref.spheres.sphere_count()) *
-           double(ref.spheres.patch_count()) * q * q;
+    const double points = double(ref.spheres.sphere_count()) * double(ref.spheres.patch_count()) * q * q;
+    return points * (double(sizeof(Entry)) * double(level.size()) + sizeof(glm::vec3) + 2 * sizeof(std::uint32_t));
   }
 
   /// The lookups of level k of `set` at the evaluation points of `ref`, on o.threads threads.
@@ -618,7 +629,8 @@ class LevelLookups {
     entries_.resize(n * apls_);
     count_.assign(n, 0);
     clamped_.assign(n, 0);
-    const float min_r = float(effective_min_distance(set, o.irradiance));
+    min_r_ = float(effective_min_distance(set, o.irradiance));
+    ignore_normal_ = o.irradiance.ignore_normal;
     const glm::mat3 to_map = level.frame.to_map;
     const glm::mat3* turn = level.frame.is_identity() ? nullptr : &to_map;
     const std::size_t jobs = std::min<std::size_t>(n, 64);
@@ -627,11 +639,12 @@ class LevelLookups {
         Entry* out = entries_.data() + i * apls_;
         std::size_t count = 0, clamped = 0;
         for (std::size_t a = 0; a < apls_; ++a) {
-          SphereMap::Footprint f;
-          float weight;
-          if (!apl_lookup(level.apls[a], points.x[i], points.normal_of(i), min_r, o.irradiance.ignore_normal, turn, f,
-                          weight, clamped))
+          glm::vec3 w;
+          float cosine, r2;
+          if (!apl_geometry(level.apls[a].position, points.x[i], points.normal_of(i), min_r_, ignore_normal_, w, cosine,
+                            r2, clamped))
             continue;
+          const SphereMap::Footprint f = level.apls[a].map.footprint(turn ? *turn * w : w);
           Entry& e = out[count++];
           e.apl = std::uint32_t(a);
           // A footprint inside the square: texel (x0, y0) of the map and its right and lower neighbours;
@@ -642,7 +655,7 @@ class LevelLookups {
           e.texel = inside ? std::uint32_t(p - level.apls[a].map.data()) : kSeam;
           e.tx = f.tx;
           e.ty = f.ty;
-          e.weight = weight;
+          e.weight = cosine * 1.0f / r2;  // irradiance()'s weight with visibility 1, to the bit
         }
         count_[i] = std::uint32_t(count);
         clamped_[i] = std::uint32_t(clamped);
@@ -652,11 +665,13 @@ class LevelLookups {
 
   /// Level k of `set` against `ref` (as evaluate_level, the same bits). Throws std::invalid_argument when
   /// the level is not laid out as the one the lookups were taken from (its APLs, their positions, maps'
-  /// resolutions and channels, or its frame) or `ref` has other evaluation points.
+  /// resolutions and channels, or its frame, compared bit for bit), the irradiance options or the set's
+  /// bounds give another clamp distance or normal rule, or `ref` has other evaluation points. Its
+  /// ns_per_evaluation, when timed, is of the blends alone.
   LevelErrors evaluate(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref,
                        const AplErrorOptions& o) const {
     const AplLevel& level = set.levels.at(k);
-    check(level, ref);
+    check(set, level, ref, o);
     LevelErrors row;
     row.level = int(k);
     row.apls = level.size();
@@ -679,6 +694,8 @@ class LevelLookups {
   // The level's layout: what the lookups depend on besides the maps' values.
   std::size_t apls_ = 0;
   int resolution_ = 0;
+  float min_r_ = 0;             ///< the clamp distance (effective_min_distance) the weights were taken with
+  bool ignore_normal_ = false;  ///< and IrradianceOptions::ignore_normal
   glm::mat3 to_map_{1.0f};
   std::vector<glm::vec3> positions_;
   std::vector<int> channels_;
@@ -687,15 +704,28 @@ class LevelLookups {
   std::vector<Entry> entries_;  ///< point i's at [i·apls, i·apls + count_[i])
   std::vector<std::uint32_t> count_, clamped_;
 
-  void check(const AplLevel& level, const ReferenceIrradiance& ref) const {
-    bool same = level.size() == apls_ && level.map_resolution == resolution_ && level.frame.to_map == to_map_ &&
-                ref.spheres.subsamples_for(level.map_resolution, apls_) == subsamples_ &&
-                EvaluationPoints(ref.spheres, subsamples_).x == points_;
+  template <class T>
+  static bool same_bits(const T& a, const T& b) {
+    return std::memcmp(&a, &b, sizeof(T)) == 0;
+  }
+
+  void check(const AplSet& set, const AplLevel& level, const ReferenceIrradiance& ref, const AplErrorOptions& o) const {
+    bool same = level.size() == apls_ && level.map_resolution == resolution_ &&
+                same_bits(level.frame.to_map, to_map_) &&
+                same_bits(float(effective_min_distance(set, o.irradiance)), min_r_) &&
+                o.irradiance.ignore_normal == ignore_normal_ &&
+                ref.spheres.subsamples_for(level.map_resolution, apls_) == subsamples_;
+    if (same) {
+      const EvaluationPoints points(ref.spheres, subsamples_);
+      same = points.x.size() == points_.size() &&
+             std::memcmp(points.x.data(), points_.data(), points_.size() * sizeof(glm::vec3)) == 0;
+    }
     for (std::size_t a = 0; same && a < apls_; ++a)
-      same = level.apls[a].position == positions_[a] && level.apls[a].map.resolution() == resolution_ &&
+      same = same_bits(level.apls[a].position, positions_[a]) && level.apls[a].map.resolution() == resolution_ &&
              level.apls[a].map.channels() == channels_[a];
     if (!same)
-      throw std::invalid_argument("LevelLookups: the level or the reference is not the one they were taken for");
+      throw std::invalid_argument(
+          "LevelLookups: the level, its irradiance options or the reference are not the ones they were taken for");
   }
 
   /// irradiance()'s sum at point i: the blends in APL order, their texels prefetched 32 APLs ahead.
@@ -763,9 +793,10 @@ inline LevelErrors evaluate_far_field(const AplSet& set, const ReferenceIrradian
   row.apls = 1;
   row.map_resolution = level.map_resolution;
   row.bytes = level.map_bytes();
-  detail::evaluate_rows(ref, options, row, [&](std::size_t, const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
-    return far_field_irradiance(set, x, n, options.irradiance, clamped);
-  });
+  detail::evaluate_rows(ref, options, row,
+                        [&](std::size_t, const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
+                          return far_field_irradiance(set, x, n, options.irradiance, clamped);
+                        });
   return row;
 }
 
@@ -1236,7 +1267,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
             return applied.back().second;
           }
         if (applied.size() >= applied_kept) applied.erase(applied.begin());
-        applied.emplace_back(kern.kappa(), kernel_applied_maps(at_r, kern));
+        applied.emplace_back(kern.kappa(), kernel_applied_maps(at_r, kern, o.threads));
         return applied.back().second;
       };
       for (const FitKernel& kernel : set_rays > 0 && !at_r.apls.empty() ? fit_kernels(R) : std::vector<FitKernel>{}) {
@@ -1272,7 +1303,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         const auto [lowering, allowance] = kernel_peak_change(
             sum_at_r, plain_mode ? kern.apply(sum_at_r) : kern.apply_with_gain(sum_at_r, gain), set_rays);
         if (lowering > allowance) continue;
-        set.levels[k] = level_from_applied(at_r, applied_for(kern), kern, kernel.mode, gain);
+        set.levels[k] = level_from_applied(at_r, applied_for(kern), kern, kernel.mode, gain, o.threads);
         grade(R, kappa, kernel.mode, kernel_errors);
         // A kernel must not give away any distance against the same maps unsmoothed: its bias is largest at
         // a narrow peak, which patches coarser than the peak see only in part, at some distances
@@ -1339,7 +1370,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     // kernel width tried.
     if (best.kappa > 0)
       set.levels[k] = smoothed_level_with_gain(set.levels[k], *kernel_for(best.resolution, best.kappa), best.mode,
-                                               eligible.at(best_at).gain);
+                                               eligible.at(best_at).gain, o.threads);
     choice.resolution.push_back(best.resolution);
     choice.kappa.push_back(best.kappa);
     choice.mode.push_back(best.kappa > 0 ? best.mode : KernelMode::plain);

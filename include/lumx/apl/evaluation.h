@@ -61,24 +61,20 @@ inline glm::vec3 apl_direction(const glm::vec3& p, const glm::vec3& x, float& r,
   return r > 0 ? d * (1.0f / r) : glm::vec3(0, 0, -1);
 }
 
-/// What irradiance() reads of one APL for a point x with normal n, before any texel: the direction w
-/// (apl_direction), r clamped to `min_r` (counted in `clamped`), and, where the receiver faces the APL
-/// (cos = −n·w > 0, or ignore_normal), the map's bilinear footprint at w (turned into the map's frame
-/// when `to_map` is given) and the weight cos/r². Returns false where the APL does not light x; its
-/// contribution is then blend(footprint) × weight × visibility.
-inline bool apl_lookup(const Apl& a, const glm::vec3& x, const glm::vec3& n, float min_r, bool ignore_normal,
-                       const glm::mat3* to_map, SphereMap::Footprint& footprint, float& weight, std::size_t& clamped) {
-  float r, r2;
-  const glm::vec3 w = apl_direction(a.position, x, r, r2);
+/// What irradiance() computes of one APL for a point x with normal n before it reads the map: the
+/// direction w (apl_direction), r² with r clamped to `min_r` (counted in `clamped`), and the receiver's
+/// cosine (−n·w, or 1 with ignore_normal). Returns false where the APL does not light x (cosine ≤ 0);
+/// else its contribution is blend(footprint(w in the map's frame)) × cosine × visibility / r².
+inline bool apl_geometry(const glm::vec3& p, const glm::vec3& x, const glm::vec3& n, float min_r, bool ignore_normal,
+                         glm::vec3& w, float& cosine, float& r2, std::size_t& clamped) {
+  float r;
+  w = apl_direction(p, x, r, r2);
   if (r < min_r) {
     r2 = min_r * min_r;
     ++clamped;
   }
-  const float cosine = ignore_normal ? 1.0f : -glm::dot(n, w);
-  if (cosine <= 0.0f) return false;
-  footprint = a.map.footprint(to_map ? *to_map * w : w);
-  weight = cosine / r2;
-  return true;
+  cosine = ignore_normal ? 1.0f : -glm::dot(n, w);
+  return cosine > 0.0f;
 }
 }  // namespace detail
 
@@ -106,14 +102,15 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
     std::size_t count = 0;
     for (std::size_t i = begin; i < end; ++i) {
       const Apl& a = level.apls[i];
-      float weight;
-      if (!detail::apl_lookup(a, x, n, min_r, options.ignore_normal, turned ? &to_map : nullptr, footprints[count],
-                              weight, result.clamped))
+      glm::vec3 w;
+      float cosine, r2;
+      if (!detail::apl_geometry(a.position, x, n, min_r, options.ignore_normal, w, cosine, r2, result.clamped))
         continue;
       const float v = visibility(i, a.position, x);
       if (v <= 0.0f) continue;
+      footprints[count] = a.map.footprint(turned ? to_map * w : w);
       for (const float* t : footprints[count].texel) __builtin_prefetch(t);
-      weights[count] = weight * v;
+      weights[count] = cosine * v / r2;
       index[count] = i;
       ++count;
     }

@@ -131,7 +131,7 @@ HeldOutEvaluation evaluate_bundle_levels(RaySource& rays, const BundleBuildOptio
   // Maps at the resolutions the whole rayset's set will have (the fit only coarsens).
   AplBuildOptions half = half_rays_build_options(with_threads(o.apl), rays.info().ray_count);
   half.progress = progress_span(o, 0.0, 0.5);
-  eo.threads = unsigned(half.threads);  // the grading's points, as many threads as the build
+  if (eo.threads == 0) eo.threads = unsigned(half.threads);  // the grading's points: the build's threads
   eo.progress = progress_span(o, 0.5, 1.0);
   const auto build_half = [&](RaySource& train) { return build_apl_set(train, half); };
   result.report = result.fitted ? evaluate_held_out_fitted(rays, build_half, eo, &result.choice)
