@@ -3,8 +3,8 @@
 # Copyright Contributors to the lumx project.
 # Builds lumx (installing missing Debian packages first). Usage: scripts/build.sh [--sanitize]
 #   default      -> build/        (RelWithDebInfo with -g1: line tables and function names for backtraces,
-#                                  no variable locations, which cost 40 % of the compile time; warnings
-#                                  as errors)
+#                                  no variable locations, which cost a third of the compile time: one
+#                                  test file 49.7 s with -g, 32.0 s with -g1; warnings as errors)
 #   --sanitize   -> build-asan/   (Debug, AddressSanitizer + UndefinedBehaviorSanitizer)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -618,6 +618,7 @@ class LevelLookups {
     apls_ = level.size();
     resolution_ = level.map_resolution;
     to_map_ = level.frame.to_map;
+    turned_ = !level.frame.is_identity();
     for (const Apl& a : level.apls) {
       positions_.push_back(a.position);
       channels_.push_back(a.map.channels());
@@ -631,8 +632,6 @@ class LevelLookups {
     clamped_.assign(n, 0);
     min_r_ = float(effective_min_distance(set, o.irradiance));
     ignore_normal_ = o.irradiance.ignore_normal;
-    const glm::mat3 to_map = level.frame.to_map;
-    const glm::mat3* turn = level.frame.is_identity() ? nullptr : &to_map;
     const std::size_t jobs = std::min<std::size_t>(n, 64);
     parallel_jobs(jobs, o.threads, [&](std::size_t j) {
       for (std::size_t i = n * j / jobs; i < n * (j + 1) / jobs; ++i) {
@@ -644,7 +643,7 @@ class LevelLookups {
           if (!apl_geometry(level.apls[a].position, points.x[i], points.normal_of(i), min_r_, ignore_normal_, w, cosine,
                             r2, clamped))
             continue;
-          const SphereMap::Footprint f = level.apls[a].map.footprint(turn ? *turn * w : w);
+          const SphereMap::Footprint f = level.apls[a].map.footprint(turned_ ? to_map_ * w : w);
           Entry& e = out[count++];
           e.apl = std::uint32_t(a);
           // A footprint inside the square: texel (x0, y0) of the map and its right and lower neighbours;
@@ -697,6 +696,7 @@ class LevelLookups {
   float min_r_ = 0;             ///< the clamp distance (effective_min_distance) the weights were taken with
   bool ignore_normal_ = false;  ///< and IrradianceOptions::ignore_normal
   glm::mat3 to_map_{1.0f};
+  bool turned_ = false;  ///< to_map_ is not the identity (most sets: no 3×3 multiply per lookup)
   std::vector<glm::vec3> positions_;
   std::vector<int> channels_;
   std::vector<glm::vec3> points_;  ///< the evaluation points they were taken at
@@ -730,8 +730,6 @@ class LevelLookups {
 
   /// irradiance()'s sum at point i: the blends in APL order, their texels prefetched 32 APLs ahead.
   glm::vec3 sum_at(const AplLevel& level, std::size_t i) const {
-    const glm::mat3 to_map = level.frame.to_map;
-    const bool turned = !level.frame.is_identity();
     constexpr std::size_t kChunk = 32;
     const Entry* e = entries_.data() + i * apls_;
     const std::size_t n = count_[i];
@@ -754,7 +752,7 @@ class LevelLookups {
         } else {
           float r, r2;
           const glm::vec3 w = apl_direction(positions_[e[j].apl], points_[i], r, r2);
-          fj = map.footprint(turned ? to_map * w : w);
+          fj = map.footprint(turned_ ? to_map_ * w : w);  // check(): the level's frame is to_map_
         }
         for (const float* t : fj.texel) __builtin_prefetch(t);
       }
