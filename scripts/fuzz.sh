@@ -23,11 +23,7 @@ ci=0
 if [ "${1:-}" = "--ci" ]; then ci=1; shift; set -- all "${1:-20}"; fi
 which=${1:-all}
 seconds=${2:-60}
-bash scripts/deps.sh >&2
-dpkg-query -W -f='${Status}' clang libclang-rt-dev 2>/dev/null | grep -c 'install ok installed' | grep -q 2 || {
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-dev >&2
-}
+bash scripts/deps.sh clang libclang-rt-dev >&2
 launcher=()
 if command -v ccache > /dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
