@@ -6,7 +6,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=$(bash scripts/build.sh "$@" | tail -n 1)
 bash scripts/gltf_validator.sh  # the Khronos glTF-Validator for the glTF writer's test (npm, into out/tools/)
-skip=()
 if [ "${1:-}" = "--sanitize" ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   export LSAN_OPTIONS="suppressions=$(pwd)/scripts/lsan.supp"
@@ -32,6 +31,8 @@ if [ "${1:-}" = "--sanitize" ]; then
     'RandomStreams\.(InterleavedFirstDrawsOfConsecutiveStreamsAreUniformAndIndependent|TheStatisticsRejectFlawedStreams|StreamsNeverRepeatEachOther)'
     'AplErrorLevels\.LevelZeroFarAwayIsNearTheNoiseFloorWithTheBuilderRule'
   )
-  skip=(-E "^($(IFS='|'; echo "${left_out[*]}"))\$")
+  # The sanitized build registers one CTest test per suite (tests/tools/suite_tests.cmake), which leaves
+  # out the tests whose full name matches this pattern.
+  export LUMX_TESTS_LEFT_OUT="^($(IFS='|'; echo "${left_out[*]}"))\$"
 fi
-ctest --test-dir "$dir" --output-on-failure -j "$(nproc)" "${skip[@]}"
+ctest --test-dir "$dir" --output-on-failure -j "$(nproc)"

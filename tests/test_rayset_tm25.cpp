@@ -3,6 +3,7 @@
 // The TM-25 writer: write-then-read is exact (the rays' bits, the header), writing is atomic, values TM-25
 // cannot hold are refused; and rays stream in bounded memory (a 2 M-ray file written and read with peak
 // RSS growth far below its size), with the read speed on the largest real file reported.
+#include "memory_test_support.h"
 #include "rayset_test_support.h"
 
 #include <lumx/io/rayset_io.h>
@@ -43,22 +44,6 @@ std::int64_t ulps(float a, float b) {
   std::memcpy(&ia, &a, 4);
   std::memcpy(&ib, &b, 4);
   return std::abs(static_cast<std::int64_t>(ia) - ib);
-}
-
-long proc_status_kb(const char* key) {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind(key, 0) == 0) return std::stol(line.substr(std::strlen(key)));
-  return -1;
-}
-
-/// Resets the peak RSS to the current RSS (Linux clear_refs 5); false if the kernel refuses.
-bool reset_peak_rss() {
-  std::ofstream f("/proc/self/clear_refs");
-  f << "5";
-  f.flush();
-  return static_cast<bool>(f);
 }
 
 }  // namespace
@@ -317,21 +302,21 @@ TEST(RaysetMemory, TwoMillionRaysStreamInBoundedMemory) {
   GeneratedRays gen(n);
   RaysetInfo info = gen.info();
   info.header_flux = 0.001 * (n / 7 * 28.0);  // about the sum: 1..7 mW cycling
-  const bool reset = reset_peak_rss();
-  const long rss0 = proc_status_kb("VmRSS:");
+  const bool reset = lumx_test::reset_peak_rss();
+  const long rss0 = lumx_test::proc_status_kb("VmRSS:");
   write_tm25(f.string(), info, gen);
-  const long write_peak = proc_status_kb("VmHWM:") - rss0;
+  const long write_peak = lumx_test::proc_status_kb("VmHWM:") - rss0;
   const auto bytes = fs::file_size(f);
   EXPECT_EQ(bytes, 36288 + n * 28);
 
   malloc_trim(0);  // hand the writer's freed buffers back, so that reading must fault in its own pages
-  reset_peak_rss();
-  const long rss1 = proc_status_kb("VmRSS:");
+  lumx_test::reset_peak_rss();
+  const long rss1 = lumx_test::proc_status_kb("VmRSS:");
   const auto t0 = std::chrono::steady_clock::now();
   auto src = open_rayset(f.string());
   const RaysetSummary s = summarize_rays(*src);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const long read_peak = proc_status_kb("VmHWM:") - rss1;
+  const long read_peak = lumx_test::proc_status_kb("VmHWM:") - rss1;
   EXPECT_EQ(s.rays, n);
   EXPECT_GT(s.flux_sum, 0);
   if (!reset) GTEST_SKIP() << "the kernel refused to reset the peak RSS; growth not measured";

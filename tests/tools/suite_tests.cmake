@@ -1,0 +1,54 @@
+# SPDX-License-Identifier: Apache-2.0
+# Copyright Contributors to the lumx project.
+# Read by CTest (a TEST_INCLUDE_FILES script, tests/CMakeLists.txt) in the sanitized build: registers one
+# CTest test per GoogleTest suite of lumx_tests instead of one per test. A sanitized process takes about
+# 0.28 s to start and to check for leaks at exit, so the ~580 tests cost about 160 s of start-ups alone;
+# ~100 suites cost a sixth of that.
+#
+# The test list comes from the program itself (--gtest_list_tests), each time CTest runs, so the groups
+# hold exactly the program's tests. Tests whose full name matches the CMake regular expression in the
+# environment variable LUMX_TESTS_LEFT_OUT are not run (scripts/test.sh --sanitize sets it).
+#
+# Set by the including file: LUMX_TESTS (the program), LUMX_TESTS_DIR (working directory), LUMX_TESTS_TIMEOUT.
+
+execute_process(COMMAND "${LUMX_TESTS}" --gtest_list_tests
+                WORKING_DIRECTORY "${LUMX_TESTS_DIR}" OUTPUT_VARIABLE listing RESULT_VARIABLE status TIMEOUT 120)
+if(NOT status EQUAL 0)
+  # Makes the failure a failing test with the program's own message, rather than an empty suite.
+  add_test(lumx_tests.list "${LUMX_TESTS}" --gtest_list_tests)
+  return()
+endif()
+
+# The listing: "Suite." lines (instantiated suites "Prefix/Suite."), then "  Test" lines; parameterised
+# suites and tests carry a "  # TypeParam = …" or "  # GetParam() = …" comment, removed first because
+# its text may hold ';' or brackets, which would break the list.
+string(REGEX REPLACE "  #[^\n]*" "" listing "${listing}")
+string(REPLACE ";" "" listing "${listing}")
+string(REPLACE "\n" ";" lines "${listing}")
+set(left_out "$ENV{LUMX_TESTS_LEFT_OUT}")
+set(suites "")
+set(suite "")
+foreach(line IN LISTS lines)
+  if(line MATCHES "^([^ ]+)\\.$")
+    set(suite "${CMAKE_MATCH_1}")
+    string(MAKE_C_IDENTIFIER "${suite}" id)
+    set(tests_${id} "")
+  elseif(line MATCHES "^  ([^ ]+)$" AND NOT suite STREQUAL "")
+    set(name "${suite}.${CMAKE_MATCH_1}")
+    if(NOT left_out STREQUAL "" AND name MATCHES "${left_out}")
+      continue()
+    endif()
+    if(tests_${id} STREQUAL "")
+      list(APPEND suites "${suite}")
+    endif()
+    list(APPEND tests_${id} "${name}")
+  endif()
+endforeach()
+
+# One test per suite, in the program's order, running exactly the suite's remaining tests by name.
+foreach(suite IN LISTS suites)
+  string(MAKE_C_IDENTIFIER "${suite}" id)
+  list(JOIN tests_${id} ":" filter)
+  add_test("${suite}" "${LUMX_TESTS}" "--gtest_filter=${filter}")
+  set_tests_properties("${suite}" PROPERTIES WORKING_DIRECTORY "${LUMX_TESTS_DIR}" TIMEOUT "${LUMX_TESTS_TIMEOUT}")
+endforeach()
