@@ -484,8 +484,9 @@ TEST(AplErrorLevels, DeterministicWhateverTheChunkSizeAndThreadCount) {
 }
 
 // The fit grades every candidate at one resolution through the lookups of the first: the same bits as
-// evaluate_level, for maps of other values, in a turned frame, with clamped distances; another layout,
-// other irradiance options or another reference are refused.
+// evaluate_level, for maps of other values, in a turned frame, with clamped distances, and with the
+// lookups of a third of the points (a memory budget); another layout, other irradiance options or another
+// reference are refused.
 TEST(AplErrorLevels, LookupsKeptForALayoutGiveEvaluateLevelsBits) {
   MemoryRaySource rays = ring_rays(60000, 23);
   AplSet set = build_fixed(rays, 16, {1, 8, 64});
@@ -497,6 +498,11 @@ TEST(AplErrorLevels, LookupsKeptForALayoutGiveEvaluateLevelsBits) {
     if (turned) set.levels[2].frame.to_map = glm::mat3(glm::rotate(glm::mat4(1.0f), 0.7f, glm::normalize(glm::vec3(1, 2, 3))));
     ASSERT_EQ(set.levels[2].frame.is_identity(), !turned);
     const lumx::detail::LevelLookups lookups(set, 2, ref, o);
+    const double all_bytes = lumx::detail::LevelLookups::bytes_for(set, 2, ref);
+    const lumx::detail::LevelLookups third(set, 2, ref, o, all_bytes / 3);
+    ASSERT_GT(third.points_looked_up(), 0u);
+    ASSERT_LT(3 * third.points_looked_up(), lookups.points_looked_up() + 3);
+    EXPECT_EQ(lumx::detail::LevelLookups(set, 2, ref, o, all_bytes).points_looked_up(), lookups.points_looked_up());
     for (int candidate = 0; candidate < 2; ++candidate) {
       if (candidate == 1)  // other values in the same layout, as a smoothing gives
         for (Apl& a : set.levels[2].apls)
@@ -507,6 +513,9 @@ TEST(AplErrorLevels, LookupsKeptForALayoutGiveEvaluateLevelsBits) {
         const LevelErrors direct = evaluate_level(set, 2, ref, o), kept = lookups.evaluate(set, 2, ref, o);
         EXPECT_EQ(kept.irradiance, direct.irradiance) << turned << candidate << threads;
         EXPECT_EQ(kept.clamped, direct.clamped);
+        const LevelErrors part = third.evaluate(set, 2, ref, o);
+        EXPECT_EQ(part.irradiance, direct.irradiance) << turned << candidate << threads;
+        EXPECT_EQ(part.clamped, direct.clamped);
         EXPECT_GT(kept.clamped, 0u);
         for (std::size_t s = 0; s < ref.sphere.size(); ++s)
           EXPECT_EQ(kept.errors[s].relative_rmse, direct.errors[s].relative_rmse);

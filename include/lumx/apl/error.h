@@ -97,7 +97,6 @@
 #include <functional>
 #include <memory>
 #include <numeric>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -601,19 +600,23 @@ namespace detail {
 /// weights), kept so that levels differing from it only in their maps' values (the fit's candidates at
 /// one resolution: one level's maps downsampled, then smoothed in turn) are evaluated by the blends
 /// alone, to the same bits as evaluate_level. Memory: 20 bytes per point and APL (the fit's 12 288 points,
-/// R 32 patches on six spheres, × 512 APLs: 126 MB).
+/// R 32 patches on six spheres, × 512 APLs: 126 MB). Under a memory budget, the lookups of as many points
+/// as it holds are kept (the first ones, in evaluation order), and the other points are evaluated as
+/// evaluate_level does: the same bits either way.
 class LevelLookups {
  public:
-  /// The bytes LevelLookups(set, k, ref, o) would hold.
+  /// The bytes LevelLookups(set, k, ref, o) would hold for every point.
   static double bytes_for(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref) {
     const AplLevel& level = set.levels.at(k);
     const double q = double(ref.spheres.subsamples_for(level.map_resolution, level.size()));
     const double points = double(ref.spheres.sphere_count()) * double(ref.spheres.patch_count()) * q * q;
-    return points * (double(sizeof(Entry)) * double(level.size()) + sizeof(glm::vec3) + 2 * sizeof(std::uint32_t));
+    return points * bytes_per_point(level.size());
   }
 
-  /// The lookups of level k of `set` at the evaluation points of `ref`, on o.threads threads.
-  LevelLookups(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref, const AplErrorOptions& o) {
+  /// The lookups of level k of `set` at the evaluation points of `ref`, on o.threads threads: of every
+  /// point, or of as many of the first points as `max_bytes` holds (bytes_for: at most that much).
+  LevelLookups(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref, const AplErrorOptions& o,
+               double max_bytes = INFINITY) {
     const AplLevel& level = set.levels.at(k);
     apls_ = level.size();
     resolution_ = level.map_resolution;
@@ -625,8 +628,9 @@ class LevelLookups {
     }
     subsamples_ = ref.spheres.subsamples_for(level.map_resolution, apls_);
     const EvaluationPoints points(ref.spheres, subsamples_);
-    const std::size_t n = points.x.size();
     points_ = points.x;
+    const double held = std::floor(std::max(0.0, max_bytes) / bytes_per_point(apls_));
+    const std::size_t n = held < double(points.x.size()) ? std::size_t(held) : points.x.size();
     entries_.resize(n * apls_);
     count_.assign(n, 0);
     clamped_.assign(n, 0);
@@ -662,6 +666,10 @@ class LevelLookups {
     });
   }
 
+  /// The points whose lookups are kept (the first ones in evaluation order); of all of them when equal to
+  /// the number of evaluation points.
+  std::size_t points_looked_up() const { return count_.size(); }
+
   /// Level k of `set` against `ref` (as evaluate_level, the same bits). Throws std::invalid_argument when
   /// the level is not laid out as the one the lookups were taken from (its APLs, their positions, maps'
   /// resolutions and channels, or its frame, compared bit for bit), the irradiance options or the set's
@@ -676,7 +684,12 @@ class LevelLookups {
     row.apls = level.size();
     row.map_resolution = level.map_resolution;
     row.bytes = level.map_bytes();
-    evaluate_rows(ref, o, row, [&](std::size_t i, const glm::vec3&, const glm::vec3&, std::size_t* clamped) {
+    evaluate_rows(ref, o, row, [&](std::size_t i, const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
+      if (i >= count_.size()) {  // beyond the budget: as evaluate_level
+        const IrradianceResult r = irradiance(set, k, x, n, o.irradiance);
+        if (clamped) *clamped += r.clamped;
+        return luminance_of(set.channels, r.irradiance);
+      }
       if (clamped) *clamped += clamped_[i];
       return luminance_of(set.channels, glm::dvec3(sum_at(level, i)));
     });
@@ -690,6 +703,9 @@ class LevelLookups {
     std::uint32_t texel;  ///< offset of SphereMap::Footprint::texel[0] in the map's values; kSeam: across a seam
     float tx, ty, weight;
   };
+  static double bytes_per_point(std::size_t apls) {
+    return double(sizeof(Entry)) * double(apls) + sizeof(glm::vec3) + 2 * sizeof(std::uint32_t);
+  }
   // The level's layout: what the lookups depend on besides the maps' values.
   std::size_t apls_ = 0;
   int resolution_ = 0;
@@ -702,7 +718,7 @@ class LevelLookups {
   std::vector<glm::vec3> points_;  ///< the evaluation points they were taken at
   int subsamples_ = 1;
   std::vector<Entry> entries_;  ///< point i's at [i·apls, i·apls + count_[i])
-  std::vector<std::uint32_t> count_, clamped_;
+  std::vector<std::uint32_t> count_, clamped_;  ///< per point looked up: the first count_.size() points
 
   template <class T>
   static bool same_bits(const T& a, const T& b) {
@@ -1185,6 +1201,8 @@ inline constexpr double kAppliedBytes = 128.0 * 1024.0 * 1024.0;
 /// The memory fit_map_resolutions may keep the lookups of one level at one resolution in
 /// (detail::LevelLookups), so that its candidates there are graded by their blends alone: 128 MiB, a
 /// 512-APL level at the 12 288 points of R 32 patches (the fit's for up to 10⁶ rays: fit_patch_resolution).
+/// A level with more points and APLs keeps the lookups of as many points as this holds (10⁷ rays: the
+/// 49 152 points of R 64 patches, a quarter of them for 512 APLs, half for 256).
 inline constexpr double kLookupBytes = 128.0 * 1024.0 * 1024.0;
 
 /// The error beyond which the kernel guard of fit_map_resolutions does not protect a distance (relative RMSE).
@@ -1222,10 +1240,11 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       eligible.push_back({tried.back(), std::move(last_values), std::move(gain)});
       if (tried.back().cost < best.cost) best = tried.back(), best_at = eligible.size() - 1;
     };
-    // The lookups of the level at the current R: every candidate there has its layout (kLookupBytes).
-    std::optional<detail::LevelLookups> lookups;
+    // The lookups of the level at the current R, of as many points as kLookupBytes holds: every candidate
+    // there has its layout.
+    std::unique_ptr<const detail::LevelLookups> lookups;
     const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
-      LevelErrors row = lookups ? lookups->evaluate(set, k, ref, o) : evaluate_level(set, k, ref, o);
+      LevelErrors row = lookups->evaluate(set, k, ref, o);
       last_values = std::move(row.irradiance);
       errors.clear();
       for (const IrradianceErrors& e : row.errors) errors.push_back(e.relative_rmse);
@@ -1245,8 +1264,8 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       const AplLevel at_r = downsampled_level(built, R);
       const SphereMap sum_at_r = level_sum(at_r);
       set.levels[k] = at_r;
-      lookups.reset();
-      if (detail::LevelLookups::bytes_for(set, k, ref) <= kLookupBytes) lookups.emplace(set, k, ref, o);
+      lookups.reset();  // the last resolution's, freed before these are taken
+      lookups = std::make_unique<const detail::LevelLookups>(set, k, ref, o, kLookupBytes);
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       admit(SphereMap());
       // The cost of the last two-scale candidate admitted at this R, and whether a wider one may still win.
