@@ -10,7 +10,7 @@ if [ "${1:-}" = "--sanitize" ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   export LSAN_OPTIONS="suppressions=$(pwd)/scripts/lsan.supp"
   # Tests the release run (the README's command) keeps and the sanitized run leaves out: each repeats, at
-  # ten times the cost under the sanitizers, code that a smaller test of the same module runs there. The
+  # three times the cost under the sanitizers, code that a smaller test of the same module runs there. The
   # longest remaining tests run a short form (tests/test_support.h, kSanitized); the held-out and
   # shipped-set suites skip themselves.
   left_out=(

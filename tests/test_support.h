@@ -36,7 +36,7 @@ inline std::filesystem::path fresh_temp_dir(const std::string& name) {
   return p;
 }
 
-/// True in the sanitizer build (Debug, ASan + UBSan: about ten times slower and more at -O0), where the
+/// True in the sanitizer build (Debug at -Og, ASan + UBSan: about three times slower, ten at -O0), where the
 /// longest tests run a short form of the same code paths (coarser maps, fewer rays); the release run keeps
 /// the full form and its figures.
 #if defined(__SANITIZE_ADDRESS__)
@@ -45,7 +45,7 @@ constexpr bool kSanitized = true;
 constexpr bool kSanitized = false;
 #endif
 
-/// In the sanitizer build (about ten times slower), every `stride`-th item of a sweep over real files, and
+/// In the sanitizer build (about three times slower), every `stride`-th item of a sweep over real files, and
 /// how many the release build's bound on the count should be divided by; elsewhere everything, and 1.
 /// Sweeps keep every file in the release run; under the sanitizers a subset runs the same code paths.
 #if defined(__SANITIZE_ADDRESS__)
