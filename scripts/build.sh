@@ -8,7 +8,8 @@
 #   --sanitize   -> build-asan/   (Debug, AddressSanitizer + UndefinedBehaviorSanitizer; -g1: the reports'
 #                                  stacks need line tables only; test_bundle.cpp 32.3 s with -g, 29.6 s
 #                                  with -g1. -Og, as sanitizer builds are usually optimised a little: the
-#                                  sanitized suite ran in 198 s against 554 s at -O0, its test files took
+#                                  sanitized tests ran in 198 s against 554 s at -O0 (CTest's total
+#                                  of scripts/test.sh --sanitize), its test files took
 #                                  1 005 against 771 CPU-s to compile. clang compiles in 40 % less time,
 #                                  but its -O0 code ran the numerical tests at half gcc's speed,
 #                                  AplErrorLevels.ErrorDecreases… 38.9 against 18.9 s, and four tests

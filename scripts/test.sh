@@ -23,7 +23,7 @@ if [ "${1:-}" = "--sanitize" ]; then
     'FitReference\.ThePilotsShapeMovesPatchMeansToPatchCentres' 'SphereMapKernel\.NoiseFreeSpotsShowWhatTexelMapsCanDo'
     'BakeExactIrradiance\..*' 'AplBuilder\.(ClustersByLineOnlyWhenTheLinesMeet|ConvergencePlacementFindsAnEnclosedEmitter)'
     'CliBuild\.StoresAndPrintsHeldOutTablesTheLibraryReproduces'
-    # Statistics, 305 of the sanitized suite's 2 015 test-seconds: the BSDF samplers' χ² tests
+    # Statistics, 305 of the sanitized suite's 2 015 test-seconds at -O0: the BSDF samplers' χ² tests
     # (BsdfConsistency.SampleAgreesWithPdfAndEval runs every configuration), the adaptive estimator's
     # accuracy (AdaptiveKernelDensity.* stays), the random streams' batteries (every bake draws from them)
     # and the builder rule's far-away noise floor (AplErrorLevels.ErrorDecreases… grades the same way).

@@ -24,7 +24,7 @@ using namespace lumx::bake;
 namespace {
 
 #if defined(__SANITIZE_ADDRESS__)
-// The sanitizer build (about 10× slower) runs a tenth of the samples on a coarser histogram. (CI's sanitizer
+// The sanitizer build (several times slower) runs a tenth of the samples on a coarser histogram. (CI's sanitizer
 // run leaves the χ² tests out, scripts/test.sh: BsdfConsistency runs their sampling code there.)
 constexpr int kChi2Samples = 100000;
 constexpr int kChi2CosBins = 10, kChi2PhiBins = 20;

@@ -577,6 +577,17 @@ void evaluate_rows(const ReferenceIrradiance& ref, const AplErrorOptions& o, Lev
 
 /// Level `k` of `set` against the reference: errors per sphere, time per evaluation, bytes. The set's
 /// bounding sphere should be the one the reference was gathered around (evaluate_apl_errors does that).
+namespace detail {
+/// The luminance of irradiance() from level k at x (normal n), its clamped distances added to `clamped`:
+/// what evaluate_level grades at a point, and the lookups at points they do not hold.
+inline double level_luminance_at(const AplSet& set, std::size_t k, const glm::vec3& x, const glm::vec3& n,
+                                 const IrradianceOptions& options, std::size_t* clamped) {
+  const IrradianceResult r = irradiance(set, k, x, n, options);
+  if (clamped) *clamped += r.clamped;
+  return luminance_of(set.channels, r.irradiance);
+}
+}  // namespace detail
+
 inline LevelErrors evaluate_level(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref,
                                   const AplErrorOptions& options = {}) {
   const AplLevel& level = set.levels.at(k);
@@ -587,9 +598,7 @@ inline LevelErrors evaluate_level(const AplSet& set, std::size_t k, const Refere
   row.bytes = level.map_bytes();
   detail::evaluate_rows(ref, options, row,
                         [&](std::size_t, const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
-                          const IrradianceResult r = irradiance(set, k, x, n, options.irradiance);
-                          if (clamped) *clamped += r.clamped;
-                          return luminance_of(set.channels, r.irradiance);
+                          return detail::level_luminance_at(set, k, x, n, options.irradiance, clamped);
                         });
   return row;
 }
@@ -685,11 +694,7 @@ class LevelLookups {
     row.map_resolution = level.map_resolution;
     row.bytes = level.map_bytes();
     evaluate_rows(ref, o, row, [&](std::size_t i, const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
-      if (i >= count_.size()) {  // beyond the budget: as evaluate_level
-        const IrradianceResult r = irradiance(set, k, x, n, o.irradiance);
-        if (clamped) *clamped += r.clamped;
-        return luminance_of(set.channels, r.irradiance);
-      }
+      if (i >= count_.size()) return level_luminance_at(set, k, x, n, o.irradiance, clamped);  // beyond the budget
       if (clamped) *clamped += clamped_[i];
       return luminance_of(set.channels, glm::dvec3(sum_at(level, i)));
     });
