@@ -273,9 +273,9 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // The fit widens two-scale only while widening helped (fit_map_resolutions): at each level and
   // resolution, a two-scale candidate is followed by a wider one only if it graded better than the one
   // before it (on the box, σ 6.7° grades worse than 3.4°, and 10.1° is not tried).
-  // So does spectral, and on a one-APL level it tries one width.
+  // So do spectral and spectral per order, and on a one-APL level each tries one width.
   for (std::size_t k = 0; k < choice.tried.size(); ++k)
-    for (const KernelMode mode : {KernelMode::two_scale, KernelMode::spectral}) {
+    for (const KernelMode mode : {KernelMode::two_scale, KernelMode::spectral, KernelMode::spectral_per_order}) {
       std::map<int, std::vector<double>> widths;  // per resolution, the costs in the order tried
       for (const FitCandidate& c : choice.tried[k])
         if (c.mode == mode) widths[c.resolution].push_back(c.cost);
@@ -283,7 +283,7 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
         for (std::size_t i = 1; i + 1 < costs.size(); ++i)
           EXPECT_LT(costs[i], costs[i - 1]) << "level " << k << ", R " << R << ": widened after a worse width";
         if (set.levels[k].size() <= 1) {
-          EXPECT_LE(costs.size(), mode == KernelMode::spectral ? 1u : 0u) << "level " << k;
+          EXPECT_LE(costs.size(), mode == KernelMode::two_scale ? 0u : 1u) << "level " << k;
         }
       }
     }
@@ -385,15 +385,16 @@ TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
   // The finest level at d ≥ 1, as the fitted maps reach it (docs/apl_sets.md): the disk 0.90-1.00 % and
   // the rectangle 1.02-1.08 % (local linear kernels; 1.80-1.87 % when the fit graded against patch means
   // rather than centred references, FitReference above; the target is 2 %), the cos^20 spot
-  // 1.22-2.09 % (R 128, σ 5.0° spectral; 1.21-3.23 % two-scale, 1.87-2.90 % extrapolated at σ 3.4°,
-  // 1.87-3.17 % sharpened, 1.93-4.32 % when the kernels stopped at R 64), the cos^50 spot 1.14-2.87 %
-  // (R 128, σ 5.0° spectral; 1.50-3.68 % two-scale at σ 3.4°, 2.90-4.40 % sharpened at σ 1.7°, 3.0-11.3 %
-  // with R 64 chosen against patch means: SpotStudy.DISABLED_WhatMoreRaysBuy). The spots' guards lie
-  // between the spectral figures and the two-scale ones, so losing the spectral pilot fails them.
+  // 1.05-1.24 % (R 128, σ 5.0° spectral per order; 1.22-2.09 % spectral, 1.21-3.23 % two-scale,
+  // 1.87-2.90 % extrapolated at σ 3.4°, 1.87-3.17 % sharpened, 1.93-4.32 % when the kernels stopped at
+  // R 64), the cos^50 spot 1.11-1.57 % (R 128, σ 5.0° spectral per order; 1.14-2.87 % spectral,
+  // 1.50-3.68 % two-scale at σ 3.4°, 2.90-4.40 % sharpened at σ 1.7°, 3.0-11.3 % with R 64 chosen against
+  // patch means: SpotStudy.DISABLED_WhatMoreRaysBuy). The spots' guards are the 2 % target, which the
+  // per-degree pilot missed (2.09 and 2.87 % at d = 10), so losing the per-order candidate fails them.
   // The box with holes: 37.0-41.3 % (49.3-53.1 % when the half set's maps were one step coarser than the
   // shipped set's, so the fit could not choose the resolution the shipped set is built at); exact maps at
   // R 64 are 33-36 % off there (PinholeBoxStudy.DISABLED_ExactBeamsAtTheSourcesBoundWhatMapsCanDo).
-  const double guard[] = {0.0125, 0.0125, 0.025, 0.033, 0.45};
+  const double guard[] = {0.0125, 0.0125, 0.02, 0.02, 0.45};
   for (std::size_t s = 0; s < ms.sphere_count(); ++s) {
     const double d = ms.relative_distances()[s];
     if (d >= 1) {
@@ -884,10 +885,10 @@ TEST(SpotStudy, DISABLED_SpotBiasAndNoise) {
   constexpr int K = 4;
   // [turned][cos^20, cos^50][RMS of a set, bias, noise][d = 0.5 … 10], % (docs/apl_sets.md).
   const double documented[2][2][3][6] = {
-      {{{1.33, 1.29, 1.24, 1.29, 1.51, 1.53}, {0.36, 0.42, 0.38, 0.00, 0.44, 0.53}, {1.28, 1.22, 1.18, 1.29, 1.44, 1.43}},
+      {{{1.34, 1.30, 1.27, 1.20, 1.27, 1.26}, {0.38, 0.45, 0.38, 0.00, 0.00, 0.04}, {1.28, 1.22, 1.21, 1.20, 1.27, 1.26}},
        {{1.39, 1.35, 1.38, 1.39, 2.91, 3.71}, {0.57, 0.46, 0.45, 0.52, 1.80, 2.59}, {1.27, 1.27, 1.30, 1.29, 2.29, 2.65}}},
-      {{{1.30, 1.25, 1.28, 1.30, 1.47, 1.50}, {0.29, 0.48, 0.45, 0.32, 0.59, 0.64}, {1.26, 1.15, 1.20, 1.26, 1.35, 1.35}},
-       {{1.38, 1.31, 1.34, 1.43, 2.25, 2.54}, {0.55, 0.34, 0.44, 0.54, 1.23, 1.48}, {1.27, 1.26, 1.27, 1.33, 1.88, 2.06}}}};
+      {{{1.31, 1.25, 1.28, 1.10, 0.95, 0.92}, {0.35, 0.51, 0.45, 0.00, 0.00, 0.00}, {1.26, 1.15, 1.20, 1.10, 0.95, 0.92}},
+       {{1.40, 1.32, 1.35, 1.32, 1.44, 1.50}, {0.59, 0.42, 0.48, 0.33, 0.00, 0.00}, {1.27, 1.25, 1.26, 1.28, 1.44, 1.50}}}};
   for (const double turn : {0.0, 45.0}) {
     for (int which : {2, 3}) {
       std::unique_ptr<AnalyticEmitter> em = suite_emitter(which);

@@ -1093,7 +1093,11 @@ struct FitKernel {
 /// apl_sets.md); and spectral (SphereMapKernel::spectral_gain: as two-scale, the level's shape from its
 /// sum's harmonic expansion shrunk degree by degree, which no kernel's width can match on a narrow lobe: a
 /// cos^20 spot's finest level 2.53/3.23 → 1.98/2.09 % at d = 5/10) at the same widths and on the same terms,
-/// one width on a one-APL level. R 128's kernels are for
+/// one width on a one-APL level; and spectral per order (harmonic_estimate_per_order: the expansion about the
+/// sum's mean direction, shrunk per degree and order, which removes the noise a round beam's empty orders
+/// hold and so goes below the bound of every per-degree weight, but loses power a beam that is not round
+/// holds at orders it cannot see) at the same widths, only where the sum is a beam (mean resultant length
+/// at least kMinPerOrderResultant). R 128's kernels are for
 /// narrow lobes: a spot read through R 64 texels keeps their blur (a cos^20 spot's far field 4 % off,
 /// noise-free), and R 128 with a kernel as wide as R 64's averages the same noise through finer texels
 /// (apl_sets.md).
@@ -1108,8 +1112,14 @@ inline std::vector<FitKernel> fit_kernels(int R) {
   for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::extrapolated});
   for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::two_scale});
   for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::spectral});
+  for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::spectral_per_order});
   return out;
 }
+
+/// The mean resultant length from which the fit tries spectral per order: a beam, as the builder turns a
+/// set's maps from (kMinMapFrameResultant, apl/builder.h; a cos^m lobe with m ≥ 8). A broad emitter's
+/// mean direction is no axis of symmetry (a Lambertian panel's rectangle is not round about its normal).
+inline constexpr double kMinPerOrderResultant = 0.9;
 
 /// How much a kernel lowers a level's brightest directions, relative, and how much their mean may move by
 /// its own noise. The level's maps are summed (its far field); the brightest directions are the texels of
@@ -1274,8 +1284,9 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       admit(SphereMap());
       // The cost of the last two-scale candidate admitted at this R, and whether a wider one may still win.
-      double two_scale_before = INFINITY, spectral_before = INFINITY;
+      double two_scale_before = INFINITY, spectral_before = INFINITY, per_order_before = INFINITY;
       bool two_scale_improving = true, spectral_improving = true;
+      bool per_order_improving = glm::length(mean_direction(sum_at_r)) >= kMinPerOrderResultant;
       // K·f of every map, per kernel width at this R, kept for the other modes of that width (1.5 and 3
       // texel widths serve five or six candidates each): the widths used last, as many as kAppliedBytes
       // holds, at most three (a width smoothed once or twice per R, not once per candidate; the same bits).
@@ -1313,6 +1324,8 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         // widened while that helps; on one map the width only sets the estimate's reach, so one width.
         if (kernel.mode == KernelMode::spectral && (R != built.map_resolution || !spectral_improving)) continue;
         if (kernel.mode == KernelMode::spectral) spectral_improving = false;
+        if (kernel.mode == KernelMode::spectral_per_order && (R != built.map_resolution || !per_order_improving)) continue;
+        if (kernel.mode == KernelMode::spectral_per_order) per_order_improving = false;
         // A kernel may not flatten a peak the rays resolve: its bias is largest at a narrow lobe, where a
         // patch-mean reference is flattened too and so cannot see it (a cos^50 spot: σ 1.7° lowered the
         // peak 4 %, against a 2.5 % allowance, and doubled the far field's error at d = 10). Kept with the
@@ -1345,6 +1358,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         if (kernel.mode == KernelMode::spectral) {
           spectral_improving = built.size() > 1 && tried.back().cost < spectral_before;
           spectral_before = tried.back().cost;
+        }
+        if (kernel.mode == KernelMode::spectral_per_order) {
+          per_order_improving = built.size() > 1 && tried.back().cost < per_order_before;
+          per_order_before = tried.back().cost;
         }
         admit(gain);
       }

@@ -49,10 +49,12 @@ LUMX_NAMESPACE_BEGIN
 /// its leading two orders of blur cancelled where sharpening cancels one). two_scale: each map smoothed by K, the level's shape from
 /// its sum sharpened at half K's width (SphereMapKernel::two_scale_gain). spectral: each map smoothed by K,
 /// the level's shape from its sum's harmonic expansion shrunk degree by degree (SphereMapKernel::spectral_gain).
-enum class KernelMode { plain, sharpened, local_linear, extrapolated, two_scale, spectral };
+/// spectral_per_order: as spectral, the expansion taken about the sum's mean direction and shrunk per degree
+/// and order (harmonic_estimate_per_order: for round beams).
+enum class KernelMode { plain, sharpened, local_linear, extrapolated, two_scale, spectral, spectral_per_order };
 
-/// "", "sharpened", "local linear", "extrapolated", "two-scale" or "spectral" (for reports and the bundle's
-/// provenance).
+/// "", "sharpened", "local linear", "extrapolated", "two-scale", "spectral" or "spectral per order" (for
+/// reports and the bundle's provenance).
 inline const char* kernel_mode_name(KernelMode mode) {
   switch (mode) {
     case KernelMode::sharpened: return "sharpened";
@@ -60,6 +62,7 @@ inline const char* kernel_mode_name(KernelMode mode) {
     case KernelMode::extrapolated: return "extrapolated";
     case KernelMode::two_scale: return "two-scale";
     case KernelMode::spectral: return "spectral";
+    case KernelMode::spectral_per_order: return "spectral per order";
     default: return "";
   }
 }
@@ -359,10 +362,12 @@ class SphereMapKernel {
   /// oracle-weighted expansion; apl_sets.md). For one map (a one-APL level) the result is that estimate,
   /// inside this kernel's reach of the rays. 0 where K·total is 0. `cache`, when given, keeps the
   /// expansion for the next call with the same sum.
-  SphereMap spectral_gain(const SphereMap& total, HarmonicEstimateCache* cache = nullptr) const {
+  /// With `per_order`, the shape is harmonic_estimate_per_order(total)'s.
+  SphereMap spectral_gain(const SphereMap& total, HarmonicEstimateCache* cache = nullptr, bool per_order = false) const {
     SphereMap sum(resolution_, 1);
     accumulate_channels(sum, total);
-    return pilot_gain(sum, cache ? cache->estimate(sum) : harmonic_estimate(sum).estimate);
+    if (cache) return pilot_gain(sum, cache->estimate(sum, 0, per_order));
+    return pilot_gain(sum, per_order ? harmonic_estimate_per_order(sum).estimate : harmonic_estimate(sum).estimate);
   }
 
   /// apply(in) multiplied texel by texel by `gain` (one channel, this resolution), each channel then
@@ -461,13 +466,15 @@ class SphereMapKernel {
   }
 
   /// The gain of `mode` for maps that sum to `total` (sharpening_gain, local_linear_gain, extrapolated_gain
-  /// two_scale_gain or spectral_gain, with `cache` if given; all ones for plain).
+  /// two_scale_gain or spectral_gain (per order for spectral_per_order), with `cache` if given; all ones for
+  /// plain).
   SphereMap gain(const SphereMap& total, KernelMode mode, HarmonicEstimateCache* cache = nullptr) const {
     if (mode == KernelMode::sharpened) return sharpening_gain(total);
     if (mode == KernelMode::local_linear) return local_linear_gain(total);
     if (mode == KernelMode::extrapolated) return extrapolated_gain(total);
     if (mode == KernelMode::two_scale) return two_scale_gain(total);
     if (mode == KernelMode::spectral) return spectral_gain(total, cache);
+    if (mode == KernelMode::spectral_per_order) return spectral_gain(total, cache, true);
     SphereMap ones(resolution_, 1);
     std::fill(ones.values().begin(), ones.values().end(), 1.0f);
     return ones;
