@@ -173,7 +173,7 @@ TEST(SphereMapHarmonics, ShrunkEstimateOfALobeBeatsEveryKernelAndKeepsFlux) {
 TEST(SphereMapHarmonics, TurnedAnalysisKeepsThePowerPerDegreeAndComesBack) {
   // Turning the frame mixes the orders of a degree but keeps its power (the addition theorem): a cos^20
   // lobe's 20 000 rays at R 32, turned to its axis and not. Synthesis then analysis in one turned frame
-  // returns the coefficients (to R 32's quadrature error at degree 10, as the untouched frame does).
+  // returns the coefficients (to R 64's quadrature error at degree 10, as the untouched frame does).
   const glm::dvec3 axis = glm::normalize(glm::dvec3(1, 0, 1));
   const SphereMap map = lobe_rays(32, 20, axis, 20000, 5);
   const SphereMapHarmonics h(32, 16);

@@ -1111,8 +1111,12 @@ inline std::vector<FitKernel> fit_kernels(int R) {
   for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::local_linear});
   for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::extrapolated});
   for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::two_scale});
-  for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::spectral});
-  for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::spectral_per_order});
+  // Spectral and spectral per order width by width: both smooth each map by the same kernel, so the second
+  // finds the first's K·f still kept (fit_map_resolutions keeps two or three widths for a large level).
+  for (double widths : {1.5, 3.0, 4.5}) {
+    out.push_back({kappa_of(widths), KernelMode::spectral});
+    out.push_back({kappa_of(widths), KernelMode::spectral_per_order});
+  }
   return out;
 }
 
@@ -1288,7 +1292,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       bool two_scale_improving = true, spectral_improving = true;
       bool per_order_improving = glm::length(mean_direction(sum_at_r)) >= kMinPerOrderResultant;
       // K·f of every map, per kernel width at this R, kept for the other modes of that width (1.5 and 3
-      // texel widths serve five or six candidates each): the widths used last, as many as kAppliedBytes
+      // texel widths serve six or seven candidates each): the widths used last, as many as kAppliedBytes
       // holds, at most three (a width smoothed once or twice per R, not once per candidate; the same bits).
       std::vector<std::pair<double, std::vector<SphereMap>>> applied;  // least recently used first
       const std::size_t applied_kept = std::size_t(

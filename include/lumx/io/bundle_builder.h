@@ -59,7 +59,7 @@ struct BundleBuildResult {
   double far_field_lm = 0;                ///< flux of the attached far field (lm)
   int far_field_resolution = 0;           ///< level 0's map resolution it was tabulated from
   double far_field_kernel_sigma_deg = 0;  ///< σ of the kernel its maps were smoothed with (°; 0: none)
-  KernelMode far_field_kernel_mode = KernelMode::plain;  ///< how that kernel smoothed (sharpened, local linear, extrapolated, two-scale, spectral)
+  KernelMode far_field_kernel_mode = KernelMode::plain;  ///< how that kernel smoothed (sharpened, local linear, extrapolated, two-scale, spectral, spectral per order)
   std::uint64_t bytes = 0;                ///< the bundle's payload bytes (manifest total)
   double seconds_build = 0, seconds_evaluation = 0, seconds_far_field = 0, seconds_write = 0;
   std::vector<std::string> notes;         ///< what was left out and why (no far field, no error tables)

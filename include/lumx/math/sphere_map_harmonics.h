@@ -394,7 +394,7 @@ inline glm::dvec3 mean_direction(const SphereMap& map) {
 /// pair (ĉ_l,m, ĉ_l,−m) alone, times the read blur's transfer as harmonic_estimate's. The noise per
 /// coefficient is harmonic_estimate's (the top quarter of the degrees, whose power does not depend on the
 /// frame). A cos^50 lobe from 10⁶ rays at R 128: 2.07 and 1.59 % where per degree gives 4.16 and 2.46 %
-/// (two seeds; SphereMapHarmonics.PerOrderEstimateOfARoundBeam). It is told nothing of the beam's form, but
+/// (two seeds; SphereMapHarmonics.PerOrderEstimateOfARoundBeamGoesBelowEveryPerDegreeWeight). It is told nothing of the beam's form, but
 /// it trusts each order only as far as its own few coefficients show power: a beam that is not round
 /// loses the orders whose power starts at degrees where their weight has already fallen (an elliptical
 /// beam 0.08 × 0.25 rad: 22 % against 4.4–5.3 % per degree). So it is a candidate the held-out fit grades
@@ -406,11 +406,13 @@ inline HarmonicEstimate harmonic_estimate_per_order(const SphereMap& map, unsign
   HarmonicEstimate out;
   out.degree = harmonic_estimate_degree(R);
   out.estimate = SphereMap(R, 1);
+  if (!(flux > 0)) return out;
   const glm::dvec3 mean = mean_direction(sum);
-  if (!(flux > 0) || !(glm::length(mean) > 0)) return out;
-  const glm::dmat3 Q = rotation_to_pole(mean);
+  // A density with no mean direction (symmetric about the centre) has no axis to prefer: the map's own.
+  const glm::dmat3 Q = glm::length(mean) > 0 ? rotation_to_pole(mean) : glm::dmat3(1.0);
   const SphereMapHarmonics h(R, out.degree);
   std::vector<double> c = h.analyse(sum, Q, threads);
+  const std::vector<double> raw = c;  // the weights are ruled on the unweighted coefficients
   const std::vector<double> p = h.power(c);
   const int L = out.degree;
   out.noise_per_coefficient = detail::tail_noise_per_coefficient(p);
@@ -420,7 +422,7 @@ inline HarmonicEstimate harmonic_estimate_per_order(const SphereMap& map, unsign
   };
   // The power of order |m| at degree l: ĉ_lm² + ĉ_l,−m² (one coefficient for m = 0).
   const auto order_power = [&](int l, int m) {
-    const double a = c[std::size_t(l * (l + 1) + m)], z = m > 0 ? c[std::size_t(l * (l + 1) - m)] : 0.0;
+    const double a = raw[std::size_t(l * (l + 1) + m)], z = m > 0 ? raw[std::size_t(l * (l + 1) - m)] : 0.0;
     return a * a + z * z;
   };
   out.weight.assign(std::size_t(L) + 1, 0.0);
