@@ -762,7 +762,7 @@ namespace {
 // does) from 1 M and 4 M rays, against the exact irradiance. Noise falls as 1/√N and, the kernel
 // narrowing as the rays allow, the error falls at least that fast where noise limits it (both spots at
 // σ 5.0°, spectral in the photometric frame, spectral per order turned: 4 M rays take the finest level,
-// turned, under 1.2 % at every d ≥ 1). Then, from the 1 M rays, the finest level at R 128 with σ = 1.5 texel
+// turned, to at most 1.2 % at every d ≥ 1). Then, from the 1 M rays, the finest level at R 128 with σ = 1.5 texel
 // widths, sharpened, set by hand (the fit's choice for the cos^50 spot before the extrapolated and
 // two-scale kernels). Then the floor of maps at the spot's centre: one APL whose map is the exact
 // intensity averaged over each texel, at R 64 and 128. The built rows twice: with the maps in the

@@ -1112,7 +1112,7 @@ inline std::vector<FitKernel> fit_kernels(int R) {
   for (double widths : {1.5, 3.0}) out.push_back({kappa_of(widths), KernelMode::extrapolated});
   for (double widths : {1.5, 3.0, 4.5}) out.push_back({kappa_of(widths), KernelMode::two_scale});
   // Spectral and spectral per order width by width: both smooth each map by the same kernel, so the second
-  // finds the first's K·f still kept (fit_map_resolutions keeps two or three widths for a large level).
+  // finds the first's K·f still kept (fit_map_resolutions keeps the last one to three widths used).
   for (double widths : {1.5, 3.0, 4.5}) {
     out.push_back({kappa_of(widths), KernelMode::spectral});
     out.push_back({kappa_of(widths), KernelMode::spectral_per_order});
