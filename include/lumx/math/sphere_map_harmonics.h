@@ -393,8 +393,9 @@ inline glm::dvec3 mean_direction(const SphereMap& map) {
 /// degrees l−2..l+2 and both signs of m, made non-increasing in l per order and capped by the rule on the
 /// pair (ĉ_l,m, ĉ_l,−m) alone, times the read blur's transfer as harmonic_estimate's. The noise per
 /// coefficient is harmonic_estimate's (the top quarter of the degrees, whose power does not depend on the
-/// frame). A cos^50 lobe from 10⁶ rays at R 128: 2.07 and 1.59 % where per degree gives 4.16 and 2.46 %
-/// (two seeds; SphereMapHarmonics.PerOrderEstimateOfARoundBeamGoesBelowEveryPerDegreeWeight). It is told nothing of the beam's form, but
+/// frame). A cos^50 lobe from 10⁶ rays at R 128: 1.59 % where per degree gives 2.46 %
+/// (SphereMapHarmonics.PerOrderEstimateOfARoundBeamGoesBelowEveryPerDegreeWeight; another seed 2.07 against
+/// 4.16 %, and the beams that are not round below, in a trial docs/apl_sets.md records). It is told nothing of the beam's form, but
 /// it trusts each order only as far as its own few coefficients show power: a beam that is not round
 /// loses the orders whose power starts at degrees where their weight has already fallen (an elliptical
 /// beam 0.08 × 0.25 rad: 22 % against 4.4–5.3 % per degree). So it is a candidate the held-out fit grades
