@@ -1,0 +1,276 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// lumx/math/direction_mask.h — the set of directions light leaves one point in, with borders as geometry.
+//
+// A point source behind apertures (a box with holes, an LED behind a shutter) lights a set of directions
+// with perfectly sharp borders. A texel map reads such a border through interpolated texels and is wrong
+// in a band a texel or so wide at every resolution a bundle can afford (docs/apl_sets.md, "What maps can
+// do on the box at all"). The rays themselves locate the border far more finely: n rays spread over an
+// aperture find its edge to about its length / n.
+//
+// A DirectionMask stores that set as a union of caps: the directions are split into connected groups
+// (directions closer than `link_angle` are linked), and each group becomes the convex hull of its
+// directions in the gnomonic chart about the group's mean direction. The gnomonic projection maps great
+// circles to straight lines, so each hull is a geodesically convex spherical polygon; its solid angle is
+// the spherical excess Σαᵢ − (k − 2)π (Girard's theorem). A hull of points drawn inside a convex region
+// lies inside it, and its missing area shrinks like (2k/3)·ln n / n of the area for a k-gon (Rényi &
+// Sulanke 1963), so for n = 56 000 rays through a rectangular hole about 0.07 % of the hole's solid angle
+// is missed, at the border.
+//
+// Within the mask a texel map still carries the intensity. coverage() is the lit fraction of every texel
+// of a map; a texel value is flux over the whole texel, so intensity inside the mask is the bilinear value
+// over the bilinear coverage (a normalised convolution, Knutsson & Westin 1993): a beam of constant
+// intensity reads back exactly, up to its border, however coarse the map.
+//
+// Limits: a group must fit within `max_half_angle` of its mean direction (a gnomonic chart ends at 90°),
+// and a non-convex group is covered by its hull (an L-shaped aperture lights its notch). from_directions
+// says why it refuses.
+#pragma once
+
+#include <lumx/math/constants.h>
+#include <lumx/math/sphere_map.h>
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <numeric>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+LUMX_NAMESPACE_BEGIN
+
+struct DirectionMaskOptions {
+  /// rad: directions closer than this are linked into one group (up to about 3.5× further may be: the
+  /// link is between neighbouring cells of this size). Larger than the rays' spacing inside a beam,
+  /// smaller than the gaps between beams.
+  double link_angle = 0.03;
+  /// Groups of fewer directions are stray rays, not a beam: dropped (their light is outside the mask).
+  std::size_t min_group = 64;
+  /// rad: the widest a group may reach from its mean direction (the gnomonic chart ends at π/2).
+  double max_half_angle = 1.2;
+};
+
+/// A union of geodesically convex spherical polygons ("caps"), each the hull of one group of directions.
+class DirectionMask {
+ public:
+  struct Cap {
+    glm::dvec3 axis{0, 0, 1}, e1{1, 0, 0}, e2{0, 1, 0};  ///< the chart: centre and tangent basis
+    std::vector<glm::dvec2> hull;  ///< counter-clockwise vertices in the chart (w·e1, w·e2) / (w·axis)
+    double min_cos = 1;            ///< the least w·axis of the hull's vertices: a quick reject
+  };
+
+  /// The mask of `directions` (unit vectors, any order). Returns nothing, with the reason in `why`, when
+  /// no group has min_group directions or a group is wider than max_half_angle. Throws
+  /// std::invalid_argument naming the index of a direction that is not finite and of unit length (±1e-3).
+  /// Deterministic: the same directions in the same order give the same mask (the groups do not depend
+  /// on the order; a cap's chart axis, a sum, does to rounding).
+  static std::optional<DirectionMask> from_directions(const std::vector<glm::dvec3>& directions,
+                                                      const DirectionMaskOptions& options = {},
+                                                      std::string* why = nullptr);
+
+  const std::vector<Cap>& caps() const { return caps_; }
+
+  /// Whether unit direction w lies in some cap (on a border counts as inside).
+  bool contains(const glm::dvec3& w) const {
+    for (const Cap& c : caps_) {
+      const double z = glm::dot(w, c.axis);
+      if (z < c.min_cos - 1e-12 || z <= 0) continue;
+      if (inside_hull(c.hull, {glm::dot(w, c.e1) / z, glm::dot(w, c.e2) / z})) return true;
+    }
+    return false;
+  }
+
+  /// sr: the caps' total solid angle (Girard's theorem per cap; caps of one mask do not overlap when
+  /// their groups were apart by more than the hulls reach, which the caller's link_angle decides).
+  double solid_angle() const {
+    double total = 0;
+    for (const Cap& c : caps_) total += cap_solid_angle(c);
+    return total;
+  }
+
+  /// The lit fraction of every texel of a map of square resolution R whose directions turn into the
+  /// mask's frame by `map_to_mask` (a rotation), from sub × sub equal-area sub-directions per texel.
+  SphereMap coverage(int resolution, const glm::mat3& map_to_mask, int sub = 4) const {
+    if (sub < 1 || sub > 64) throw std::invalid_argument("DirectionMask::coverage: sub " + std::to_string(sub) + " outside [1, 64]");
+    SphereMap out(resolution, 1);
+    const float inv = 1.0f / float(sub * sub);
+    for (int y = 0; y < resolution; ++y)
+      for (int x = 0; x < 2 * resolution; ++x) {
+        // Texels whose centre is far from every cap cannot hold a lit sub-direction: skip them. A texel's
+        // mean width is 2.5 / R rad and the squares stretch it by at most about 1.5, so no point of it is
+        // 4 / R rad from its centre.
+        const glm::vec2 centre((float(x) + 0.5f) / float(2 * resolution), (float(y) + 0.5f) / float(resolution));
+        const glm::dvec3 wc = glm::normalize(glm::dvec3(map_to_mask * sphere_map::uv_to_direction(centre)));
+        if (!near_a_cap(wc, 4.0 / double(resolution))) continue;
+        int lit = 0;
+        for (int j = 0; j < sub; ++j)
+          for (int i = 0; i < sub; ++i) {
+            const glm::vec2 uv((float(x) + (float(i) + 0.5f) / float(sub)) / float(2 * resolution),
+                               (float(y) + (float(j) + 0.5f) / float(sub)) / float(resolution));
+            lit += contains(glm::normalize(glm::dvec3(map_to_mask * sphere_map::uv_to_direction(uv))));
+          }
+        out.at(x, y, 0) = float(lit) * inv;
+      }
+    return out;
+  }
+
+  /// Intensity inside the mask from a map of the whole texels' flux and the mask's coverage of the same
+  /// resolution, both read bilinearly in map direction m; w is the same direction in the mask's frame.
+  /// Outside the mask: 0. Coverage below `min_coverage` is raised to it (a sliver of a texel that the
+  /// bilinear weights barely reach would otherwise divide noise by almost nothing).
+  glm::vec3 normalised_lookup(const SphereMap& map, const SphereMap& coverage, const glm::vec3& m, const glm::dvec3& w,
+                              float min_coverage = 1.0f / 16) const {
+    if (!contains(w)) return glm::vec3(0.0f);
+    return map.lookup(m) / std::max(min_coverage, coverage.lookup(m).x);
+  }
+
+ private:
+  static double cross2(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  }
+  static bool inside_hull(const std::vector<glm::dvec2>& h, const glm::dvec2& q) {
+    const std::size_t n = h.size();
+    for (std::size_t i = 0; i < n; ++i)
+      if (cross2(h[i], h[(i + 1) % n], q) < 0) return false;
+    return n >= 3;
+  }
+  /// Whether w is within `reach` rad of some cap's hull (a conservative test on the cap's circumcone).
+  bool near_a_cap(const glm::dvec3& w, double reach) const {
+    for (const Cap& c : caps_) {
+      const double cap_angle = std::acos(std::clamp(c.min_cos, -1.0, 1.0));
+      if (std::acos(std::clamp(glm::dot(w, c.axis), -1.0, 1.0)) <= cap_angle + reach) return true;
+    }
+    return false;
+  }
+  static double cap_solid_angle(const Cap& c) {
+    // Girard: the interior angles of the spherical polygon whose vertices are the hull's directions.
+    const std::size_t k = c.hull.size();
+    if (k < 3) return 0;
+    std::vector<glm::dvec3> v(k);
+    for (std::size_t i = 0; i < k; ++i) v[i] = glm::normalize(c.axis + c.hull[i].x * c.e1 + c.hull[i].y * c.e2);
+    double angles = 0;
+    for (std::size_t i = 0; i < k; ++i) {
+      const glm::dvec3 &a = v[(i + k - 1) % k], &b = v[i], &d = v[(i + 1) % k];
+      // The interior angle at b of a counter-clockwise polygon (seen from outside): from the tangent
+      // towards the next vertex round to the tangent towards the previous one, about b.
+      const glm::dvec3 ta = a - glm::dot(a, b) * b, td = d - glm::dot(d, b) * b;
+      double angle = std::atan2(glm::dot(glm::cross(td, ta), b), glm::dot(td, ta));
+      if (angle < 0) angle += 2 * kPi;
+      angles += angle;
+    }
+    return angles - double(k - 2) * kPi;
+  }
+
+  std::vector<Cap> caps_;
+};
+
+inline std::optional<DirectionMask> DirectionMask::from_directions(const std::vector<glm::dvec3>& directions,
+                                                                   const DirectionMaskOptions& options, std::string* why) {
+  auto refuse = [&](const std::string& reason) -> std::optional<DirectionMask> {
+    if (why) *why = reason;
+    return std::nullopt;
+  };
+  if (!(options.link_angle >= 1e-3 && options.link_angle < 1))
+    throw std::invalid_argument("DirectionMask: link_angle " + std::to_string(options.link_angle) + " outside [0.001, 1) rad");
+  if (!(options.max_half_angle > 0 && options.max_half_angle < 1.5))
+    throw std::invalid_argument("DirectionMask: max_half_angle " + std::to_string(options.max_half_angle) +
+                                " outside (0, 1.5) rad");
+  const std::size_t n = directions.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dvec3& w = directions[i];
+    const double len2 = glm::dot(w, w);
+    if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z) || std::abs(len2 - 1) > 2e-3)
+      throw std::invalid_argument("DirectionMask: direction " + std::to_string(i) + " is not a finite unit vector");
+  }
+  // Groups: directions in one cell of a cubic grid of side link_angle, or in neighbouring cells, are
+  // linked (union–find). Cells are keyed by their integer coordinates, which fit in 11 bits each for
+  // link_angle ≥ 1/1000 (|v / cell| ≤ 1000); the key packs them.
+  const double cell = options.link_angle;
+  auto coord = [&](double v) { return std::int64_t(std::floor(v / cell)) + 1024; };
+  auto key = [](std::int64_t a, std::int64_t b, std::int64_t c) { return (a << 22) | (b << 11) | c; };
+  std::unordered_map<std::int64_t, std::size_t> first_in_cell;  // cell → the smallest index in it
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), std::size_t(0));
+  auto find = [&](std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  auto unite = [&](std::size_t a, std::size_t b) {
+    a = find(a), b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the root is the group's smallest index
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int64_t k = key(coord(directions[i].x), coord(directions[i].y), coord(directions[i].z));
+    auto [it, added] = first_in_cell.emplace(k, i);
+    if (!added) unite(i, it->second);
+  }
+  for (const auto& [k, i] : first_in_cell) {
+    const std::int64_t a = k >> 22, b = (k >> 11) & 2047, c = k & 2047;
+    for (std::int64_t da = -1; da <= 1; ++da)
+      for (std::int64_t db = -1; db <= 1; ++db)
+        for (std::int64_t dc = -1; dc <= 1; ++dc) {
+          const auto it = first_in_cell.find(key(a + da, b + db, c + dc));
+          if (it != first_in_cell.end()) unite(i, it->second);
+        }
+  }
+  // Groups in order of their smallest index, whatever order the cells were visited in.
+  std::vector<std::size_t> root(n), group_of_root(n, std::size_t(-1));
+  std::vector<std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < n; ++i) {
+    root[i] = find(i);
+    if (group_of_root[root[i]] == std::size_t(-1)) group_of_root[root[i]] = groups.size(), groups.emplace_back();
+    groups[group_of_root[root[i]]].push_back(i);
+  }
+  DirectionMask mask;
+  const double min_cos = std::cos(options.max_half_angle);
+  for (const std::vector<std::size_t>& g : groups) {
+    if (g.size() < options.min_group) continue;
+    glm::dvec3 sum(0.0);
+    for (std::size_t i : g) sum += directions[i];
+    if (glm::length(sum) <= 0.5 * double(g.size()) * 1e-9) return refuse("a group of directions has no mean direction");
+    Cap cap;
+    cap.axis = glm::normalize(sum);
+    cap.e1 = glm::normalize(glm::cross(std::abs(cap.axis.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0), cap.axis));
+    cap.e2 = glm::cross(cap.axis, cap.e1);
+    std::vector<glm::dvec2> pts;
+    pts.reserve(g.size());
+    for (std::size_t i : g) {
+      const double z = glm::dot(directions[i], cap.axis) / glm::length(directions[i]);
+      if (z < min_cos)
+        return refuse("a group of " + std::to_string(g.size()) + " directions reaches " +
+                      std::to_string(std::acos(std::clamp(z, -1.0, 1.0))) + " rad from its mean direction (at most " +
+                      std::to_string(options.max_half_angle) + ")");
+      pts.push_back({glm::dot(directions[i], cap.e1) / (z * glm::length(directions[i])),
+                     glm::dot(directions[i], cap.e2) / (z * glm::length(directions[i]))});
+    }
+    // Andrew's monotone chain: counter-clockwise, collinear points dropped.
+    std::sort(pts.begin(), pts.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+    if (pts.size() < 3) continue;
+    std::vector<glm::dvec2> h(2 * pts.size());
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      while (k >= 2 && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+      h[k++] = pts[i];
+    }
+    for (std::size_t i = pts.size() - 1, lower = k + 1; i > 0; --i) {
+      while (k >= lower && cross2(h[k - 2], h[k - 1], pts[i - 1]) <= 0) --k;
+      h[k++] = pts[i - 1];
+    }
+    h.resize(k - 1);
+    if (h.size() < 3) continue;  // all on one great circle: no area
+    cap.hull = std::move(h);
+    for (const glm::dvec2& p : cap.hull) cap.min_cos = std::min(cap.min_cos, 1 / std::sqrt(1 + glm::dot(p, p)));
+    mask.caps_.push_back(std::move(cap));
+  }
+  if (mask.caps_.empty()) return refuse("no group of at least " + std::to_string(options.min_group) + " directions");
+  return mask;
+}
+
+LUMX_NAMESPACE_END
