@@ -86,8 +86,8 @@ class DirectionMask {
     return false;
   }
 
-  /// sr: the caps' total solid angle (Girard's theorem per cap; caps of one mask do not overlap when
-  /// their groups were apart by more than the hulls reach, which the caller's link_angle decides).
+  /// sr: the sum of the caps' solid angles (Girard's theorem per cap). Hulls of separate groups can
+  /// overlap (one group in another's notch); an overlap is then counted twice.
   double solid_angle() const {
     double total = 0;
     for (const Cap& c : caps_) total += cap_solid_angle(c);
