@@ -12,9 +12,13 @@
 #include <lumx/math/aabb.h>
 #include <lumx/math/bounding_sphere.h>
 #include <lumx/math/constants.h>
+#include <lumx/math/direction_mask.h>
 #include <lumx/math/line_fit.h>
 #include <lumx/math/piecewise_constant_2d.h>
+#include <lumx/math/pull_push.h>
 #include <lumx/math/sphere_map.h>
+#include <lumx/math/sphere_map_harmonics.h>
+#include <lumx/math/sphere_map_kernel.h>
 #include <lumx/math/sphere_map_sampler.h>
 #include <lumx/math/sphere_map_smoothing.h>
 #include <lumx/math/spherical_harmonics.h>
@@ -30,6 +34,7 @@
 #include <lumx/photometry/validate.h>
 
 #include <lumx/rays/far_field.h>
+#include <lumx/rays/holdout.h>
 #include <lumx/rays/rayset.h>
 
 #include <lumx/apl/apl_set.h>

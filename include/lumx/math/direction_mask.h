@@ -11,16 +11,18 @@
 // A DirectionMask stores that set as a union of caps: the directions are split into connected groups
 // (directions closer than `link_angle` are linked), and each group becomes the convex hull of its
 // directions in the gnomonic chart about the group's mean direction. The gnomonic projection maps great
-// circles to straight lines, so each hull is a geodesically convex spherical polygon; its solid angle is
-// the spherical excess Σαᵢ − (k − 2)π (Girard's theorem). A hull of points drawn inside a convex region
-// lies inside it, and its missing area shrinks like (2k/3)·ln n / n of the area for a k-gon (Rényi &
-// Sulanke 1963), so for n = 56 000 rays through a rectangular hole about 0.07 % of the hole's solid angle
-// is missed, at the border.
+// circles to straight lines, so each hull is a geodesically convex spherical polygon, whose solid angle
+// is a sum of spherical triangles. A hull of points drawn inside a convex region lies inside it, and its
+// missing area shrinks like (2k/3)·ln n / n of the area for a k-gon (Rényi & Sulanke 1963): about 0.05 %
+// of a rectangular hole's solid angle from n = 56 000 rays (one source of the box with holes in
+// docs/apl_sets.md), missed at the border.
 //
 // Within the mask a texel map still carries the intensity. coverage() is the lit fraction of every texel
 // of a map; a texel value is flux over the whole texel, so intensity inside the mask is the bilinear value
 // over the bilinear coverage (a normalised convolution, Knutsson & Westin 1993): a beam of constant
-// intensity reads back exactly, up to its border, however coarse the map.
+// intensity reads back up to its border, however coarse the map, to within the sampling of the coverage
+// (sub × sub directions a texel: up to 1/(2·sub) of a border texel's lit fraction) and, in texels lit
+// below min_coverage, that clamp.
 //
 // Limits: a group must fit within `max_half_angle` of its mean direction (a gnomonic chart ends at 90°),
 // and a non-convex group is covered by its hull (an L-shaped aperture lights its notch). from_directions
@@ -63,11 +65,14 @@ class DirectionMask {
     glm::dvec3 axis{0, 0, 1}, e1{1, 0, 0}, e2{0, 1, 0};  ///< the chart: centre and tangent basis
     std::vector<glm::dvec2> hull;  ///< counter-clockwise vertices in the chart (w·e1, w·e2) / (w·axis)
     double min_cos = 1;            ///< the least w·axis of the hull's vertices: a quick reject
+    double reach = 0;              ///< rad, acos(min_cos): the hull lies within it of the axis
   };
 
   /// The mask of `directions` (unit vectors, any order). Returns nothing, with the reason in `why`, when
-  /// no group has min_group directions or a group is wider than max_half_angle. Throws
-  /// std::invalid_argument naming the index of a direction that is not finite and of unit length (±1e-3).
+  /// no group has min_group directions, a group is wider than max_half_angle, or a group's directions
+  /// cancel (no mean direction). Throws std::invalid_argument naming the index of a direction that is not
+  /// finite and of unit length (±1e-3), or for link_angle outside [0.001, 1) or max_half_angle outside
+  /// (0, 1.5) rad.
   /// Deterministic: the same directions in the same order give the same mask (the groups do not depend
   /// on the order; a cap's chart axis, a sum, does to rounding).
   static std::optional<DirectionMask> from_directions(const std::vector<glm::dvec3>& directions,
@@ -86,7 +91,7 @@ class DirectionMask {
     return false;
   }
 
-  /// sr: the sum of the caps' solid angles (Girard's theorem per cap). Hulls of separate groups can
+  /// sr: the sum of the caps' solid angles. Hulls of separate groups can
   /// overlap (one group in another's notch); an overlap is then counted twice.
   double solid_angle() const {
     double total = 0;
@@ -102,9 +107,9 @@ class DirectionMask {
     const float inv = 1.0f / float(sub * sub);
     for (int y = 0; y < resolution; ++y)
       for (int x = 0; x < 2 * resolution; ++x) {
-        // Texels whose centre is far from every cap cannot hold a lit sub-direction: skip them. A texel's
-        // mean width is 2.5 / R rad and the squares stretch it by at most about 1.5, so no point of it is
-        // 4 / R rad from its centre.
+        // Texels whose centre is far from every cap cannot hold a lit sub-direction: skip them. No point
+        // of a texel is more than 2.63 / R rad from its centre (measured for R = 1 … 4096; the largest are
+        // next to the poles, along the squares' diagonals), so 4 / R keeps a margin of 1.5.
         const glm::vec2 centre((float(x) + 0.5f) / float(2 * resolution), (float(y) + 0.5f) / float(resolution));
         const glm::dvec3 wc = glm::normalize(glm::dvec3(map_to_mask * sphere_map::uv_to_direction(centre)));
         if (!near_a_cap(wc, 4.0 / double(resolution))) continue;
@@ -124,8 +129,12 @@ class DirectionMask {
   /// resolution, both read bilinearly in map direction m; w is the same direction in the mask's frame.
   /// Outside the mask: 0. Coverage below `min_coverage` is raised to it (a sliver of a texel that the
   /// bilinear weights barely reach would otherwise divide noise by almost nothing).
+  /// Throws std::invalid_argument when the coverage's resolution is not the map's.
   glm::vec3 normalised_lookup(const SphereMap& map, const SphereMap& coverage, const glm::vec3& m, const glm::dvec3& w,
                               float min_coverage = 1.0f / 16) const {
+    if (coverage.resolution() != map.resolution() || coverage.empty())
+      throw std::invalid_argument("DirectionMask::normalised_lookup: coverage of resolution " +
+                                  std::to_string(coverage.resolution()) + " for a map of " + std::to_string(map.resolution()));
     if (!contains(w)) return glm::vec3(0.0f);
     return map.lookup(m) / std::max(min_coverage, coverage.lookup(m).x);
   }
@@ -142,29 +151,24 @@ class DirectionMask {
   }
   /// Whether w is within `reach` rad of some cap's hull (a conservative test on the cap's circumcone).
   bool near_a_cap(const glm::dvec3& w, double reach) const {
-    for (const Cap& c : caps_) {
-      const double cap_angle = std::acos(std::clamp(c.min_cos, -1.0, 1.0));
-      if (std::acos(std::clamp(glm::dot(w, c.axis), -1.0, 1.0)) <= cap_angle + reach) return true;
-    }
+    for (const Cap& c : caps_)
+      if (std::acos(std::clamp(glm::dot(w, c.axis), -1.0, 1.0)) <= c.reach + reach) return true;
     return false;
   }
   static double cap_solid_angle(const Cap& c) {
-    // Girard: the interior angles of the spherical polygon whose vertices are the hull's directions.
+    // A fan of spherical triangles (v0, vi, vi+1) over the hull's directions, each by Van Oosterom &
+    // Strackee (1983): tan(Ω/2) = a·(b×c) / (1 + a·b + b·c + c·a). Unlike a sum of interior angles, a
+    // degenerate triangle (two vertices that round to one direction) adds 0.
     const std::size_t k = c.hull.size();
     if (k < 3) return 0;
     std::vector<glm::dvec3> v(k);
     for (std::size_t i = 0; i < k; ++i) v[i] = glm::normalize(c.axis + c.hull[i].x * c.e1 + c.hull[i].y * c.e2);
-    double angles = 0;
-    for (std::size_t i = 0; i < k; ++i) {
-      const glm::dvec3 &a = v[(i + k - 1) % k], &b = v[i], &d = v[(i + 1) % k];
-      // The interior angle at b of a counter-clockwise polygon (seen from outside): from the tangent
-      // towards the next vertex round to the tangent towards the previous one, about b.
-      const glm::dvec3 ta = a - glm::dot(a, b) * b, td = d - glm::dot(d, b) * b;
-      double angle = std::atan2(glm::dot(glm::cross(td, ta), b), glm::dot(td, ta));
-      if (angle < 0) angle += 2 * kPi;
-      angles += angle;
+    double total = 0;
+    for (std::size_t i = 1; i + 1 < k; ++i) {
+      const glm::dvec3 &a = v[0], &b = v[i], &d = v[i + 1];
+      total += 2 * std::atan2(glm::dot(a, glm::cross(b, d)), 1 + glm::dot(a, b) + glm::dot(b, d) + glm::dot(d, a));
     }
-    return angles - double(k - 2) * kPi;
+    return total;
   }
 
   std::vector<Cap> caps_;
@@ -190,7 +194,7 @@ inline std::optional<DirectionMask> DirectionMask::from_directions(const std::ve
   }
   // Groups: directions in one cell of a cubic grid of side link_angle, or in neighbouring cells, are
   // linked (union–find). Cells are keyed by their integer coordinates, which fit in 11 bits each for
-  // link_angle ≥ 1/1000 (|v / cell| ≤ 1000); the key packs them.
+  // link_angle ≥ 1/1000 (|v / cell| ≤ 1001); the key packs them.
   const double cell = options.link_angle;
   auto coord = [&](double v) { return std::int64_t(std::floor(v / cell)) + 1024; };
   auto key = [](std::int64_t a, std::int64_t b, std::int64_t c) { return (a << 22) | (b << 11) | c; };
@@ -267,6 +271,7 @@ inline std::optional<DirectionMask> DirectionMask::from_directions(const std::ve
     if (h.size() < 3) continue;  // all on one great circle: no area
     cap.hull = std::move(h);
     for (const glm::dvec2& p : cap.hull) cap.min_cos = std::min(cap.min_cos, 1 / std::sqrt(1 + glm::dot(p, p)));
+    cap.reach = std::acos(std::clamp(cap.min_cos, -1.0, 1.0));
     mask.caps_.push_back(std::move(cap));
   }
   if (mask.caps_.empty()) return refuse("no group of at least " + std::to_string(options.min_group) + " directions");
