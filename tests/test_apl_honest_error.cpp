@@ -669,6 +669,13 @@ TEST(PinholeBoxStudy, DISABLED_ExactBeamsAtTheSourcesBoundWhatMapsCanDo) {
 }  // namespace
 
 namespace {
+/// m: the distance from point c to the line through o along unit w (double: the study's tolerances reach
+/// 10⁻⁷ m, below a float's resolution of these coordinates).
+double distance_to_line(const glm::dvec3& c, const glm::dvec3& o, const glm::dvec3& w) {
+  const glm::dvec3 v = c - o;
+  return glm::length(v - glm::dot(v, w) * w);
+}
+
 // Borders as geometry on the box with holes (docs/apl_sets.md, "Beam masks"): each APL's map read inside a
 // DirectionMask (lumx/math/direction_mask.h), the hull of the directions of every ray whose line passes
 // through the APL's position, normalised by the mask's coverage of its texels. Three sets, against the
@@ -756,8 +763,7 @@ TEST(PinholeBoxStudy, DISABLED_BeamMasksDrawTheBordersTheMapsCannot) {
   std::vector<std::vector<glm::dvec3>> from(2);
   for (std::size_t j = 0; j < origin.size(); ++j)
     for (std::size_t t = 0; t < 2; ++t) {
-      const glm::dvec3 v = sources[t] - origin[j];
-      if (glm::length(v - glm::dot(v, direction[j]) * direction[j]) < 1e-5) {
+      if (distance_to_line(sources[t], origin[j], direction[j]) < 1e-5) {
         from[t].push_back(direction[j]);
         break;
       }
@@ -816,11 +822,9 @@ TEST(PinholeBoxStudy, DISABLED_BeamMasksDrawTheBordersTheMapsCannot) {
         if (glm::length(mask_at[q] - c) < eps) which = q;
       if (which == masks.size()) {
         std::vector<glm::dvec3> through;
-        for (std::size_t j = 0; j < origin.size(); ++j) {
-          const glm::dvec3 v = c - origin[j];
-          const double t = glm::dot(v, direction[j]);
-          if (t <= 0 && glm::length(v - t * direction[j]) < eps) through.push_back(direction[j]);
-        }
+        for (std::size_t j = 0; j < origin.size(); ++j)  // lines that pass c before they start
+          if (glm::dot(c - origin[j], direction[j]) <= 0 && distance_to_line(c, origin[j], direction[j]) < eps)
+            through.push_back(direction[j]);
         const auto m = through.size() >= 500 ? DirectionMask::from_directions(through) : std::nullopt;
         if (m) {
           masks.push_back(*m), mask_at.push_back(c);
@@ -859,16 +863,17 @@ TEST(PinholeBoxStudy, DISABLED_BeamMasksDrawTheBordersTheMapsCannot) {
     for (std::size_t j = 0; j < origin.size(); ++j) {
       double best = INFINITY;
       for (std::size_t a = 0; a < level.apls.size(); ++a) {
-        const glm::dvec3 v = glm::dvec3(level.apls[a].position) - origin[j];
-        line_distance[a] = glm::length(v - glm::dot(v, direction[j]) * direction[j]);
+        line_distance[a] = distance_to_line(glm::dvec3(level.apls[a].position), origin[j], direction[j]);
         best = std::min(best, line_distance[a]);
       }
       const glm::vec3 m = level.frame.map_direction(glm::vec3(direction[j]));
       std::size_t pick = 0;
       float brightest = -1;
-      for (std::size_t a = 0; a < level.apls.size(); ++a)
-        if (line_distance[a] <= best + 1e-6 * set.bounds.radius && level.apls[a].map.lookup(m).x > brightest)
-          brightest = level.apls[a].map.lookup(m).x, pick = a;
+      for (std::size_t a = 0; a < level.apls.size(); ++a) {
+        if (line_distance[a] > best + 1e-6 * set.bounds.radius) continue;
+        const float b = level.apls[a].map.lookup(m).x;
+        if (b > brightest) brightest = b, pick = a;
+      }
       int x, y;
       moved[pick].texel_of(m, x, y);
       moved[pick].at(x, y, 0) += float(ray_flux / moved[pick].texel_solid_angle());

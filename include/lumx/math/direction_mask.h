@@ -245,13 +245,14 @@ inline std::optional<DirectionMask> DirectionMask::from_directions(const std::ve
     std::vector<glm::dvec2> pts;
     pts.reserve(g.size());
     for (std::size_t i : g) {
-      const double z = glm::dot(directions[i], cap.axis) / glm::length(directions[i]);
+      // The chart's coordinates (d·e1, d·e2) / (d·axis) do not depend on |d|; the angle test does.
+      const glm::dvec3& d = directions[i];
+      const double along = glm::dot(d, cap.axis), z = along / glm::length(d);
       if (z < min_cos)
         return refuse("a group of " + std::to_string(g.size()) + " directions reaches " +
                       std::to_string(std::acos(std::clamp(z, -1.0, 1.0))) + " rad from its mean direction (at most " +
                       std::to_string(options.max_half_angle) + ")");
-      pts.push_back({glm::dot(directions[i], cap.e1) / (z * glm::length(directions[i])),
-                     glm::dot(directions[i], cap.e2) / (z * glm::length(directions[i]))});
+      pts.push_back({glm::dot(d, cap.e1) / along, glm::dot(d, cap.e2) / along});
     }
     // Andrew's monotone chain: counter-clockwise, collinear points dropped.
     std::sort(pts.begin(), pts.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });

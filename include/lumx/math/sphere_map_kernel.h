@@ -198,8 +198,9 @@ class SphereMapKernel {
   double sigma() const { return 1.0 / std::sqrt(kappa_); }
   /// Non-zero weights in all (the cost of apply, per channel).
   std::size_t weight_count() const { return weights_.size(); }
-  /// Runs of consecutive targets in all; the kernel holds 4 bytes a weight and 8 a run (R 128: 7.8 weights a
-  /// run at σ 1.5 texel widths, 14.6 at 3, 20.9 at 4.5; SphereMapKernel.BuildsAtTheLargestResolutionAndKeepsFlux).
+  /// Runs of consecutive targets in all; the kernel holds 4 bytes a weight and 8 a run (R 128 at σ 1.5 texel
+  /// widths: 7.8 weights a run, SphereMapKernel.BuildsAtTheLargestResolutionAndKeepsFlux; wider kernels have
+  /// longer runs).
   std::size_t run_count() const { return runs_.size(); }
 
   /// The smoothed map (same resolution and channels; flux kept). Throws for another resolution.
