@@ -14,6 +14,7 @@
 
 #include <lumx/core/units.h>
 #include <lumx/math/bounding_sphere.h>
+#include <lumx/math/direction_mask.h>
 #include <lumx/math/sphere_map.h>
 
 #include <glm/glm.hpp>
@@ -22,6 +23,7 @@
 #include <cmath>
 #include <cstddef>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -30,12 +32,27 @@
 LUMX_NAMESPACE_BEGIN
 
 /// One anisotropic point light.
+///
+/// A masked APL (a point source behind apertures: apl/point_sources.h) also carries the directions its
+/// light leaves in as geometry, a DirectionMask in the photometric frame. Its intensity is then
+///   I(ω) = B[map](m) / max(c_min, B[coverage](m))  for ω inside the mask, 0 outside,
+/// with m the map-frame direction, B the bilinear lookup and `coverage` each texel's lit fraction
+/// (DirectionMask::normalised_lookup): the border is the mask's, located by the rays far more finely than
+/// a texel, and the map carries only the intensity inside it (docs/apl_sets.md, "Beam masks").
 struct Apl {
   glm::vec3 position{0.0f};  ///< m, in the luminaire's photometric frame
   glm::dvec3 flux{0.0};      ///< lm or W per channel (one-channel sets repeat Y); equals map.integral()
   int parent = -1;           ///< index of the APL in the previous (coarser) level; −1 in the first level
   SphereMap map;             ///< intensity, cd or W/sr per channel, in its level's MapFrame
+  std::shared_ptr<const DirectionMask> mask;  ///< the directions it lights; null: every direction
+  SphereMap coverage;  ///< with a mask: its lit fraction of each texel of `map` (one channel, same R and frame)
 };
+
+/// Coverage below this is raised to it in a masked lookup (DirectionMask::normalised_lookup): a sliver of
+/// a texel that the bilinear weights barely reach would otherwise divide noise by almost nothing.
+inline constexpr float kMinMaskCoverage = 1.0f / 16;
+/// Sub-directions per texel side of a mask's coverage: 8 × 8, a border texel's lit fraction to ±1/16.
+inline constexpr int kMaskCoverageSubsamples = 8;
 
 /// Relative RMSE of a level's irradiance against a reference, on spheres of relative distance d
 /// (000 §5.3, eq. 5.1). Filled by the builder; read by the error-target level choice.
@@ -115,10 +132,30 @@ struct AplLevel {
   /// Bytes of map data held in memory.
   std::size_t map_bytes() const {
     std::size_t b = 0;
-    for (const Apl& a : apls) b += a.map.bytes();
+    for (const Apl& a : apls) b += a.map.bytes() + (a.mask ? a.coverage.bytes() : 0);
     return b;
   }
+  /// Whether some APL of the level carries a mask.
+  bool has_masks() const {
+    for (const Apl& a : apls)
+      if (a.mask) return true;
+    return false;
+  }
 };
+
+/// Recomputes a masked APL's coverage at its map's resolution in `frame` (no-op without a mask): wherever
+/// a map changes resolution (a fit, a partial load) its coverage must follow.
+inline void refresh_coverage(Apl& a, const MapFrame& frame) {
+  if (!a.mask) {
+    a.coverage = SphereMap();
+    return;
+  }
+  if (a.coverage.resolution() == a.map.resolution() && !a.coverage.empty()) return;
+  a.coverage = a.mask->coverage(a.map.resolution(), glm::transpose(frame.to_map), kMaskCoverageSubsamples);
+}
+inline void refresh_coverages(AplLevel& level) {
+  for (Apl& a : level.apls) refresh_coverage(a, level.frame);
+}
 
 /// A luminaire's APL set: levels ordered by increasing APL count, plus what a reader needs to use it.
 struct AplSet {
@@ -213,6 +250,9 @@ inline std::vector<std::string> check_apl_set(const AplSet& set, double flux_tol
                       std::to_string(level.map_resolution) + " × " + std::to_string(nc));
         continue;
       }
+      if (a.mask && (a.coverage.resolution() != a.map.resolution() || a.coverage.channels() != 1))
+        out.push_back(at + ".coverage: resolution " + std::to_string(a.coverage.resolution()) +
+                      " for a masked map of " + std::to_string(a.map.resolution()));
       int bx = 0, by = 0, bc = 0;
       if (!a.map.all_finite_nonnegative(&bx, &by, &bc))
         out.push_back(at + ".map: texel (" + std::to_string(bx) + ", " + std::to_string(by) + ") channel " +

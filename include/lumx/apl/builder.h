@@ -28,6 +28,10 @@
 //      (along directions the map cannot resolve, its parent's coordinate: a truncated solve; see the
 //      code), which minimises the flux-weighted squared shift across each ray that step 5 implies.
 //
+//   7. With place_at_convergence, when every ray's line passes through one of a few of those positions
+//      (point sources behind apertures), the set is rebuilt as one masked APL per source and cuts of a
+//      tree over the sources (apl/point_sources.h): their borders as geometry.
+//
 // Map resolution per level (when not fixed by the caller): a histogram of m rays over T texels has a
 // relative noise of about 1/√(m/T) per texel. A shading point sums every APL of the level, so in the mid
 // and far field the noise that matters is that of all N rays over T texels, while near the luminaire one
@@ -43,6 +47,7 @@
 
 #include <lumx/apl/clustering.h>
 #include <lumx/apl/apl_set.h>
+#include <lumx/apl/point_sources.h>
 #include <lumx/math/detail/point_kdtree.h>
 #include <lumx/math/line_fit.h>
 #include <lumx/math/sphere_map_smoothing.h>
@@ -53,6 +58,7 @@
 #include <cstdint>
 #include <functional>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -88,6 +94,9 @@ struct AplBuildOptions {
   /// Turn the maps so that the seeds' mean direction falls inside a wedge of the map (MapFrame, step 3);
   /// false keeps the photometric frame.
   bool orient_maps = true;
+  /// Step 7 (with place_at_convergence): when every ray's line passes through one of a few points, the
+  /// set of those point sources as masked APLs (apl/point_sources.h); map_smoothing_rays is then not used.
+  PointSourceOptions point_sources;
   /// Called with the fraction done (0..1) and a phase name, at most a few hundred times.
   std::function<void(double, const char*)> progress;
 };
@@ -106,6 +115,9 @@ struct AplBuildReport {
   std::vector<int> map_resolution;        ///< per level
   std::vector<std::size_t> apl_count;     ///< per level (may be below the request for tiny raysets)
   double seconds_seed = 0, seconds_tree = 0, seconds_assign = 0;
+  /// Step 7: the point sources found (0: none, the set is the clustered one) and, with none, why.
+  std::size_t point_sources = 0;
+  std::string point_source_note;
 };
 
 /// The mean resultant length |Σ flux·ω| / Σ flux from which the builder turns the maps (a beam): 0.9, a
@@ -533,6 +545,36 @@ inline AplSet build_apl_set(RaySource& rays, const AplBuildOptions& options = {}
         apl.position = glm::vec3(x);
         ++rep.moved_to_convergence;
       }
+    }
+  }
+  // ---- 7. point sources behind apertures: masked APLs at the points every line passes through
+  if (options.place_at_convergence && options.point_sources.enabled) {
+    // Candidates: each finest cluster's least-squares point of its lines solved in full (whatever the
+    // maps' resolution truncated in step 6: a cluster of one source's rays meets at that source), then
+    // the finest level's positions.
+    std::vector<glm::vec3> candidates;
+    for (std::size_t i = 0; i < lines_of.size(); ++i)
+      if (lines_of[i].weight > 0)
+        candidates.push_back(glm::vec3(lines_of[i].solve(glm::dvec3(set.levels.back().apls[i].position), 1e-9)));
+    for (const Apl& a : set.levels.back().apls) candidates.push_back(a.position);
+    const auto resolution = [&](std::size_t apls) {
+      return options.map_resolution > 0 ? options.map_resolution : map_resolution_for(rule_rays, double(apls), options);
+    };
+    PointSourceReport found;
+    std::optional<AplSet> points = build_point_source_set(rays, candidates, set.bounds, options.level_counts, resolution,
+                                                          frame, options.point_sources, options.chunk_rays, threads, &found);
+    rep.point_sources = found.sources;
+    rep.point_source_note = found.why;
+    if (points) {
+      points->quantity = set.quantity;
+      points->channels = set.channels;
+      points->provenance = set.provenance;
+      points->provenance["builder"] = "lumx build_apl_set (point sources behind apertures: " +
+                                      std::to_string(found.sources) + ", masked)";
+      set = std::move(*points);
+      rep.map_resolution.clear();
+      rep.apl_count.clear();
+      for (const AplLevel& l : set.levels) rep.map_resolution.push_back(l.map_resolution), rep.apl_count.push_back(l.size());
     }
   }
   const auto t3 = Clock::now();

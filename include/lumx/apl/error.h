@@ -627,6 +627,8 @@ class LevelLookups {
   LevelLookups(const AplSet& set, std::size_t k, const ReferenceIrradiance& ref, const AplErrorOptions& o,
                double max_bytes = INFINITY) {
     const AplLevel& level = set.levels.at(k);
+    // The lookups read plain maps; a masked level is graded by evaluate_level (fit_map_resolutions).
+    if (level.has_masks()) throw std::invalid_argument("LevelLookups: level " + std::to_string(k) + " has masked APLs");
     apls_ = level.size();
     resolution_ = level.map_resolution;
     to_map_ = level.frame.to_map;
@@ -972,6 +974,9 @@ inline AplLevel downsampled_level(const AplLevel& level, int R) {
   if (R == level.map_resolution) return out;
   for (Apl& a : out.apls) {
     while (a.map.resolution() > R) a.map = a.map.downsampled();
+    // A texel's lit fraction at R/2 is the mean of its four children's (equal areas; their sub-directions
+    // nest), so a mask's coverage is downsampled with its map, exactly.
+    while (a.mask && a.coverage.resolution() > R) a.coverage = a.coverage.downsampled();
     if (a.map.resolution() != R)
       throw std::invalid_argument("downsampled_level: " + std::to_string(R) + " is not a power-of-two fraction of " +
                                   std::to_string(level.map_resolution));
@@ -1022,6 +1027,8 @@ inline AplLevel level_from_applied(const AplLevel& level, std::vector<SphereMap>
     out.apls[i].position = level.apls[i].position;
     out.apls[i].flux = level.apls[i].flux;
     out.apls[i].parent = level.apls[i].parent;
+    out.apls[i].mask = level.apls[i].mask;
+    out.apls[i].coverage = level.apls[i].coverage;
   }
   const bool with_gain = mode != KernelMode::plain;
   detail::parallel_jobs(
@@ -1239,6 +1246,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
   HarmonicEstimateCache spectra;  // every level's sum is the same rays': one expansion for all
   for (std::size_t k = 0; k < set.levels.size(); ++k) {
     const AplLevel built = set.levels[k];
+    const bool masked = built.has_masks();
     std::vector<FitCandidate> tried;
     FitCandidate best{built.map_resolution, 0.0, INFINITY};
     // Every eligible candidate (past the kernel guards) with its model values, for the one-standard-error
@@ -1263,7 +1271,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
     // there has its layout.
     std::unique_ptr<const detail::LevelLookups> lookups;
     const auto grade = [&](int R, double kappa, KernelMode mode, std::vector<double>& errors) {
-      LevelErrors row = lookups->evaluate(set, k, ref, o);
+      LevelErrors row = lookups ? lookups->evaluate(set, k, ref, o) : evaluate_level(set, k, ref, o);
       last_values = std::move(row.irradiance);
       errors.clear();
       for (const IrradianceErrors& e : row.errors) errors.push_back(e.relative_rmse);
@@ -1284,7 +1292,10 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
       const SphereMap sum_at_r = level_sum(at_r);
       set.levels[k] = at_r;
       lookups.reset();  // the last resolution's, freed before these are taken
-      lookups = std::make_unique<const detail::LevelLookups>(set, k, ref, o, kLookupBytes);
+      // A masked level (point sources behind apertures, a few APLs) is graded point by point through
+      // irradiance(), and only as plain masked maps: a kernel would blur the intensity the mask's border
+      // divides by its coverage.
+      if (!masked) lookups = std::make_unique<const detail::LevelLookups>(set, k, ref, o, kLookupBytes);
       const double plain = grade(R, 0.0, KernelMode::plain, plain_errors);
       admit(SphereMap());
       // The cost of the last two-scale candidate admitted at this R, and whether a wider one may still win.
@@ -1307,7 +1318,7 @@ inline ResolutionChoice fit_map_resolutions(AplSet& set, const ReferenceIrradian
         applied.emplace_back(kern.kappa(), kernel_applied_maps(at_r, kern, o.threads));
         return applied.back().second;
       };
-      for (const FitKernel& kernel : set_rays > 0 && !at_r.apls.empty() ? fit_kernels(R) : std::vector<FitKernel>{}) {
+      for (const FitKernel& kernel : set_rays > 0 && !at_r.apls.empty() && !masked ? fit_kernels(R) : std::vector<FitKernel>{}) {
         const double kappa = kernel.kappa;
         // Two-scale keeps the level's sum sharp at a distance, so only where the maps are fine enough to
         // hold it: at a coarser R it traded the far field for the near field, and the fitting rays could not

@@ -20,17 +20,32 @@
 
 LUMX_NAMESPACE_BEGIN
 
+namespace detail {
+/// The factor a masked APL's bilinear value is multiplied by toward w (map-frame direction m): 0 outside
+/// its mask, 1 / max(kMinMaskCoverage, B[coverage](m)) inside (Apl's comment); 1 without a mask.
+inline float mask_factor(const Apl& a, const glm::vec3& m, const glm::vec3& w) {
+  if (!a.mask) return 1.0f;
+  if (!a.mask->contains(glm::dvec3(w))) return 0.0f;
+  return 1.0f / std::max(kMinMaskCoverage, a.coverage.lookup(m).x);
+}
+}  // namespace detail
+
 /// Intensity of one APL of `level` toward unit direction w of the photometric frame (cd or W/sr per
-/// channel; bilinear on its map, read in the level's map frame).
+/// channel; bilinear on its map, read in the level's map frame, inside its mask when it has one).
 inline glm::vec3 intensity(const AplLevel& level, const Apl& apl, const glm::vec3& w) {
-  return apl.map.lookup(level.frame.map_direction(w));
+  const glm::vec3 m = level.frame.map_direction(w);
+  const float f = detail::mask_factor(apl, m, w);
+  return f > 0 ? apl.map.lookup(m) * f : glm::vec3(0.0f);
 }
 
 /// Intensity of a whole level toward w in the far-field limit (positions ignored): Σ_i I_i(w).
 inline glm::dvec3 far_field_intensity(const AplLevel& level, const glm::vec3& w) {
   const glm::vec3 m = level.frame.map_direction(w);
   glm::dvec3 sum(0.0);
-  for (const Apl& a : level.apls) sum += glm::dvec3(a.map.lookup(m));
+  for (const Apl& a : level.apls) {
+    const float f = detail::mask_factor(a, m, w);
+    if (f > 0) sum += glm::dvec3(a.map.lookup(m) * f);
+  }
   return sum;
 }
 
@@ -108,9 +123,12 @@ IrradianceResult irradiance(const AplSet& set, std::size_t level_index, const gl
         continue;
       const float v = visibility(i, a.position, x);
       if (v <= 0.0f) continue;
-      footprints[count] = a.map.footprint(turned ? to_map * w : w);
+      const glm::vec3 m = turned ? to_map * w : w;
+      const float masked = detail::mask_factor(a, m, w);  // 1 for the usual APL without a mask
+      if (masked <= 0.0f) continue;
+      footprints[count] = a.map.footprint(m);
       for (const float* t : footprints[count].texel) __builtin_prefetch(t);
-      weights[count] = cosine * v / r2;
+      weights[count] = cosine * v / r2 * masked;
       index[count] = i;
       ++count;
     }

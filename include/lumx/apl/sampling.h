@@ -8,7 +8,10 @@
 //    direction, piecewise-constant over the equal-area map's texels (pdf_ω = pdf_uv / 4π; algorithms.md
 //    §3) in proportion to the map dilated by one texel (SphereMap::dilated). The sample's flux is the
 //    bilinear I(ω) — the same intensity every other query uses — over p_apl · pdf_ω; the dilation makes
-//    pdf_ω > 0 wherever I(ω) > 0, so the estimator is unbiased.
+//    pdf_ω > 0 wherever I(ω) > 0, so the estimator is unbiased. A masked APL (apl_set.h) is drawn from
+//    the same density: its I(ω) is positive only where the bilinear map is, inside the mask, so the
+//    sample's flux is its masked I(ω) over the same pdf (0 for a sample outside the mask: exact, at the
+//    cost of the samples the dilated texels put outside the border).
 //  - Light selection at a shading point (next-event estimation): pick one APL with probability ∝ an
 //    estimate of its contribution, Φ_i · max(0, cos θ_i) / r_i², where Φ_i is its flux (as if it were
 //    isotropic) and θ_i the angle at the receiver. Every APL that can contribute (cos θ > 0) has a
@@ -18,6 +21,7 @@
 #pragma once
 
 #include <lumx/apl/apl_set.h>
+#include <lumx/apl/evaluation.h>
 #include <lumx/math/piecewise_constant_2d.h>
 #include <lumx/math/sphere_map_sampler.h>
 
@@ -71,7 +75,7 @@ class AplEmissionSampler {
     s.direction = level_->frame.world_direction(d.direction);
     const glm::vec3 m = level_->frame.map_direction(s.direction);
     s.pdf_direction = samplers_[s.apl].pdf(m);
-    if (s.valid()) s.flux = a.map.lookup(m) / (s.pdf_apl * s.pdf_direction);
+    if (s.valid()) s.flux = a.map.lookup(m) * detail::mask_factor(a, m, s.direction) / (s.pdf_apl * s.pdf_direction);
     return s;
   }
 

@@ -29,6 +29,7 @@
 #include <lumx/math/spherical_harmonics.h>
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,9 +39,11 @@ LUMX_NAMESPACE_BEGIN
 class RadianceVolume;
 
 namespace bundle {
-inline constexpr int kFormatVersion = 2;
+inline constexpr int kFormatVersion = 3;
 /// The oldest format version this lumx reads. Version 2 added a level's optional "map_frame"; a version 1
-/// bundle's maps are in the photometric frame.
+/// bundle's maps are in the photometric frame. Version 3 added the optional "masks" (beam masks of point
+/// sources behind apertures) and a level's "mask"; a set without masks is still written as version 2, so
+/// that earlier readers read it.
 inline constexpr int kOldestFormatVersion = 1;
 inline constexpr const char* kFormatName = "lumx-bundle";
 inline constexpr const char* kManifestName = "manifest.json";
@@ -68,6 +71,7 @@ struct BundleLevelInfo {
   std::vector<glm::vec3> position;     ///< m, one per APL
   std::vector<glm::dvec3> flux;        ///< lm or W per channel, one per APL
   std::vector<int> parent;             ///< index in the previous level, −1 in the first
+  std::vector<int> mask;               ///< per APL: index in BundleManifest::masks, −1 none; empty: none masked
   std::vector<BundlePayload> maps;     ///< decreasing resolution; maps[0] is full resolution
   ErrorTable error;
   std::size_t apl_count() const { return position.size(); }
@@ -92,6 +96,9 @@ struct BundleManifest {
   BoundingSphere bounds;
   std::map<std::string, std::string> provenance;
   std::vector<BundleLevelInfo> levels;
+  /// The masks APLs refer to (apl_set.h, math/direction_mask.h), each stored once: caps as chart axis,
+  /// tangent basis and hull vertices, in the photometric frame.
+  std::vector<std::shared_ptr<const DirectionMask>> masks;
   std::optional<BundleVolumeInfo> volume;
   std::vector<std::pair<BundleAttachment, BundlePayload>> attachments;  ///< name/type and file/bytes/sha256
   std::uint64_t manifest_bytes = 0;
@@ -124,6 +131,13 @@ struct BundleLimits {
   std::uint64_t max_payload_bytes = 4ull << 30;
   std::size_t max_levels = 64;
   std::size_t max_apls_per_level = 1u << 20;
+  std::size_t max_masks = 4096;             ///< beam masks in a manifest
+  std::size_t max_caps_per_mask = 256;      ///< caps in one mask
+  std::size_t max_hull_vertices = 1u << 12; ///< vertices of one cap's hull
+  /// The reader computes each masked APL's coverage (8 × 8 sub-directions a texel, each tested against
+  /// every cap in O(log vertices)); a level whose masks would take more tests than this at its full
+  /// resolution is refused (2^31: a few seconds), so a hostile manifest cannot make loading hang.
+  std::uint64_t max_mask_tests = 1ull << 31;
   /// Largest decoded size of one payload in memory (float texels or coefficients). A compressed payload
   /// of a few megabytes can decode to gigabytes, so this bounds memory, not file size.
   std::uint64_t max_decoded_bytes = 2ull << 30;

@@ -79,6 +79,52 @@ class DirectionMask {
                                                       const DirectionMaskOptions& options = {},
                                                       std::string* why = nullptr);
 
+  /// A mask from stored caps (a bundle's): each needs an orthonormal chart (axis, e1, e2 unit and
+  /// perpendicular to 1e-5, e2 = axis × e1), at least 3 and at most kMaxHullVertices finite hull vertices,
+  /// counter-clockwise and convex, within max_half_angle of the axis; min_cos and reach are recomputed.
+  /// Throws std::invalid_argument naming the cap and what is wrong.
+  static constexpr std::size_t kMaxHullVertices = 1u << 16;
+  static DirectionMask from_caps(std::vector<Cap> caps, const DirectionMaskOptions& options = {}) {
+    if (caps.empty()) throw std::invalid_argument("no cap");
+    const double min_cos = std::cos(options.max_half_angle);
+    for (std::size_t i = 0; i < caps.size(); ++i) {
+      Cap& c = caps[i];
+      const std::string at = "cap " + std::to_string(i) + ": ";
+      const auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+      if (!finite(c.axis) || !finite(c.e1) || !finite(c.e2) || std::abs(glm::length(c.axis) - 1) > 1e-5 ||
+          std::abs(glm::length(c.e1) - 1) > 1e-5 || std::abs(glm::dot(c.axis, c.e1)) > 1e-5 ||
+          glm::length(c.e2 - glm::cross(c.axis, c.e1)) > 1e-5)
+        throw std::invalid_argument(at + "axis, e1 and e2 are not a right-handed orthonormal basis");
+      if (c.hull.size() < 3 || c.hull.size() > kMaxHullVertices)
+        throw std::invalid_argument(at + std::to_string(c.hull.size()) + " hull vertices (3 to " +
+                                    std::to_string(kMaxHullVertices) + ")");
+      c.min_cos = 1;
+      for (std::size_t v = 0; v < c.hull.size(); ++v) {
+        const glm::dvec2& p = c.hull[v];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y)) throw std::invalid_argument(at + "vertex " + std::to_string(v) + " is not finite");
+        c.min_cos = std::min(c.min_cos, 1 / std::sqrt(1 + glm::dot(p, p)));
+        const std::size_t n = c.hull.size();
+        if (cross2(c.hull[v], c.hull[(v + 1) % n], c.hull[(v + 2) % n]) <= 0)
+          throw std::invalid_argument(at + "vertices " + std::to_string(v) + " to " + std::to_string((v + 2) % n) +
+                                      " do not turn counter-clockwise: not a convex hull");
+      }
+      // Every turn left and once around (the angles about the vertices' mean add up to 2π): convex.
+      glm::dvec2 mean(0.0);
+      for (const glm::dvec2& p : c.hull) mean += p / double(c.hull.size());
+      double turn = 0;
+      for (std::size_t v = 0; v < c.hull.size(); ++v) {
+        const glm::dvec2 a = c.hull[v] - mean, b = c.hull[(v + 1) % c.hull.size()] - mean;
+        turn += std::atan2(a.x * b.y - a.y * b.x, glm::dot(a, b));
+      }
+      if (!(std::abs(turn - 2 * kPi) < 1e-6)) throw std::invalid_argument(at + "the hull winds more than once: not convex");
+      if (c.min_cos < min_cos) throw std::invalid_argument(at + "reaches beyond " + std::to_string(options.max_half_angle) + " rad of its axis");
+      c.reach = std::acos(std::clamp(c.min_cos, -1.0, 1.0));
+    }
+    DirectionMask m;
+    m.caps_ = std::move(caps);
+    return m;
+  }
+
   const std::vector<Cap>& caps() const { return caps_; }
 
   /// Whether unit direction w lies in some cap (on a border counts as inside).
@@ -143,11 +189,17 @@ class DirectionMask {
   static double cross2(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
     return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
   }
+  /// Whether q lies in the convex counter-clockwise polygon h (its border included), in O(log n): the
+  /// fan wedge from h[0] that holds q by bisection, then that wedge's outer edge.
   static bool inside_hull(const std::vector<glm::dvec2>& h, const glm::dvec2& q) {
     const std::size_t n = h.size();
-    for (std::size_t i = 0; i < n; ++i)
-      if (cross2(h[i], h[(i + 1) % n], q) < 0) return false;
-    return n >= 3;
+    if (n < 3 || cross2(h[0], h[1], q) < 0 || cross2(h[0], h[n - 1], q) > 0) return false;
+    std::size_t lo = 1, hi = n - 1;  // cross2(h0, h[lo], q) ≥ 0 > cross2(h0, h[hi], q), or hi = n − 1
+    while (hi - lo > 1) {
+      const std::size_t mid = (lo + hi) / 2;
+      (cross2(h[0], h[mid], q) >= 0 ? lo : hi) = mid;
+    }
+    return cross2(h[lo], h[lo + 1], q) >= 0;
   }
   /// Whether w is within `reach` rad of some cap's hull (a conservative test on the cap's circumcone).
   bool near_a_cap(const glm::dvec3& w, double reach) const {

@@ -209,7 +209,15 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
         info.position.push_back(a.position);
         info.flux.push_back(a.flux);
         info.parent.push_back(a.parent);
+        info.mask.push_back(-1);
+        if (!a.mask) continue;
+        // Each mask once, however many APLs share it.
+        auto same = std::find(m.masks.begin(), m.masks.end(), a.mask);
+        if (same == m.masks.end()) same = m.masks.insert(m.masks.end(), a.mask);
+        info.mask.back() = int(same - m.masks.begin());
       }
+      if (std::find_if(info.mask.begin(), info.mask.end(), [](int i) { return i >= 0; }) == info.mask.end())
+        info.mask.clear();
       std::vector<SphereMap> reduced;  // the current mip's maps (empty: use the level's own)
       int R = level.map_resolution;
       while (true) {
@@ -268,6 +276,7 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
       m.attachments.emplace_back(BundleAttachment{a.name, a.media_type, {}}, p);
     }
     // The writer's output must be what its reader accepts: parse it back before anything is replaced.
+    m.format_version = m.masks.empty() ? 2 : 3;  // earlier readers read a set without masks (bundle_io.h)
     const std::string manifest_text = detail::manifest_to_json(m);
     detail::parse_manifest(manifest_text, path + "/" + bundle::kManifestName, BundleLimits{});
     write_scratch_file(tmp, bundle::kManifestName, manifest_text, path);
@@ -432,6 +441,7 @@ AplLevel BundleReader::load_level(std::size_t k, int max_resolution) const {
     a.position = info.position[i];
     a.flux = info.flux[i];
     a.parent = info.parent[i];
+    if (!info.mask.empty() && info.mask[i] >= 0) a.mask = manifest_.masks.at(std::size_t(info.mask[i]));
     a.map = SphereMap(R, nc);
     image.read_rows(int(i) * R, int(i + 1) * R - 1, a.map.data());  // each map decodes into its own storage
     int bx = 0, by = 0, bc = 0;
@@ -450,6 +460,7 @@ AplLevel BundleReader::load_level(std::size_t k, int max_resolution) const {
       fail(file, "/levels/" + std::to_string(k) + "/flux/" + std::to_string(i),
            "manifest flux " + std::to_string(stated) + " but the map integrates to " + std::to_string(map_flux));
   }
+  refresh_coverages(level);  // a masked APL's lit fractions at the resolution loaded
   return level;
 }
 

@@ -181,12 +181,25 @@ std::string manifest_to_json(const BundleManifest& m) {
     level["position"] = pos;
     level["flux"] = flux;
     level["parent"] = l.parent;
+    if (!l.mask.empty()) level["mask"] = l.mask;
     level["maps"] = json::array();
     for (const BundlePayload& p : l.maps) level["maps"].push_back(payload_json(p, true));
     if (!l.error.empty())
       level["error_vs_distance"] = {{"relative_distance", l.error.relative_distance},
                                     {"relative_rmse", l.error.relative_rmse}};
     j["levels"].push_back(level);
+  }
+  if (!m.masks.empty()) {
+    j["masks"] = json::array();
+    for (const std::shared_ptr<const DirectionMask>& mask : m.masks) {
+      json caps = json::array();
+      for (const DirectionMask::Cap& c : mask->caps()) {
+        json hull = json::array();
+        for (const glm::dvec2& v : c.hull) hull.push_back(json::array({v.x, v.y}));
+        caps.push_back({{"axis", vec3_json(c.axis)}, {"e1", vec3_json(c.e1)}, {"e2", vec3_json(c.e2)}, {"hull", hull}});
+      }
+      j["masks"].push_back({{"caps", caps}});
+    }
   }
   if (!m.attachments.empty()) {
     j["attachments"] = json::array();
@@ -244,7 +257,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     r.fail(members.repeated(), "this name appears twice in its object; readers disagree on which value counts");
   if (!j.is_object()) r.fail("", "the manifest is not a JSON object");
   r.only(j, "", {"format", "format_version", "generator", "units", "channels", "bounding_sphere", "provenance",
-                 "levels", "volume", "attachments"});
+                 "levels", "masks", "volume", "attachments"});
   BundleManifest m;
   m.manifest_bytes = text.size();
   if (r.string(r.member(j, "", "format"), "/format") != bundle::kFormatName)
@@ -287,6 +300,45 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
       m.provenance[it.key()] = r.string(it.value(), "/provenance/" + it.key());
   }
 
+  // Masks before the levels that refer to them (a JSON object's members have no order).
+  if (const json* mj = r.optional_member(j, "masks")) {
+    if (m.format_version < 3) r.fail("/masks", "not part of format version " + std::to_string(m.format_version));
+    const json& list = r.array(*mj, "/masks", std::size_t(-1));
+    if (list.empty() || list.size() > limits.max_masks)
+      r.fail("/masks", std::to_string(list.size()) + " masks: 1 to BundleLimits::max_masks (" + std::to_string(limits.max_masks) + ")");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string at = "/masks/" + std::to_string(i);
+      r.only(list[i], at, {"caps"});
+      const json& caps = r.array(r.member(list[i], at, "caps"), at + "/caps", std::size_t(-1));
+      if (caps.empty() || caps.size() > limits.max_caps_per_mask)
+        r.fail(at + "/caps", std::to_string(caps.size()) + " caps: 1 to BundleLimits::max_caps_per_mask (" +
+                                 std::to_string(limits.max_caps_per_mask) + ")");
+      std::vector<DirectionMask::Cap> out(caps.size());
+      for (std::size_t c = 0; c < caps.size(); ++c) {
+        const std::string cp = at + "/caps/" + std::to_string(c);
+        r.only(caps[c], cp, {"axis", "e1", "e2", "hull"});
+        out[c].axis = r.vec3(r.member(caps[c], cp, "axis"), cp + "/axis");
+        out[c].e1 = r.vec3(r.member(caps[c], cp, "e1"), cp + "/e1");
+        out[c].e2 = r.vec3(r.member(caps[c], cp, "e2"), cp + "/e2");
+        const json& hull = r.array(r.member(caps[c], cp, "hull"), cp + "/hull", std::size_t(-1));
+        if (hull.size() < 3 || hull.size() > limits.max_hull_vertices)
+          r.fail(cp + "/hull", std::to_string(hull.size()) + " vertices: 3 to BundleLimits::max_hull_vertices (" +
+                                   std::to_string(limits.max_hull_vertices) + ")");
+        out[c].hull.reserve(hull.size());
+        for (std::size_t v = 0; v < hull.size(); ++v) {
+          const std::string vp = cp + "/hull/" + std::to_string(v);
+          const json& xy = r.array(hull[v], vp, 2);
+          out[c].hull.push_back({r.number(xy[0], vp + "/0"), r.number(xy[1], vp + "/1")});
+        }
+      }
+      try {
+        m.masks.push_back(std::make_shared<const DirectionMask>(DirectionMask::from_caps(std::move(out))));
+      } catch (const std::invalid_argument& e) {
+        r.fail(at, e.what());
+      }
+    }
+  }
+
   const json& levels = r.array(r.member(j, "", "levels"), "/levels", std::size_t(-1));
   if (levels.empty()) r.fail("/levels", "no level");
   if (levels.size() > limits.max_levels) r.fail("/levels", std::to_string(levels.size()) + " levels exceed BundleLimits::max_levels (" +
@@ -295,7 +347,8 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   for (std::size_t k = 0; k < levels.size(); ++k) {
     const std::string at = "/levels/" + std::to_string(k);
     const json& lj = levels[k];
-    r.only(lj, at, {"apl_count", "map_resolution", "map_frame", "position", "flux", "parent", "maps", "error_vs_distance"});
+    r.only(lj, at, {"apl_count", "map_resolution", "map_frame", "position", "flux", "parent", "mask", "maps",
+                    "error_vs_distance"});
     BundleLevelInfo l;
     const std::size_t n = std::size_t(r.integer(r.member(lj, at, "apl_count"), at + "/apl_count", 1,
                                                 (long long)limits.max_apls_per_level, "BundleLimits::max_apls_per_level"));
@@ -339,6 +392,24 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
       if (nc == 1) fv = glm::dvec3(fv.x);
       l.flux.push_back(fv);
       l.parent.push_back(int(r.integer(parent[i], at + "/parent/" + is, k == 0 ? -1 : 0, parent_max)));
+    }
+    if (const json* mk = r.optional_member(lj, "mask")) {
+      const json& list = r.array(*mk, at + "/mask", n);
+      for (std::size_t i = 0; i < n; ++i)
+        l.mask.push_back(int(r.integer(list[i], at + "/mask/" + std::to_string(i), -1, (long long)m.masks.size() - 1)));
+      // The coverage's cost at full resolution, each distinct mask once (APLs share a source's).
+      std::set<int> distinct(l.mask.begin(), l.mask.end());
+      double tests = 0;
+      for (int q : distinct) {
+        if (q < 0) continue;
+        for (const DirectionMask::Cap& c : m.masks[std::size_t(q)]->caps())
+          tests += 2.0 * l.map_resolution * l.map_resolution * double(kMaskCoverageSubsamples * kMaskCoverageSubsamples) *
+                   (1.0 + std::log2(double(c.hull.size())));
+      }
+      if (tests > double(limits.max_mask_tests))
+        r.fail(at + "/mask", "its masks' coverage at R " + std::to_string(l.map_resolution) + " would take " +
+                                 std::to_string(tests) + " tests, above BundleLimits::max_mask_tests (" +
+                                 std::to_string(limits.max_mask_tests) + ")");
     }
     const json& maps = r.array(r.member(lj, at, "maps"), at + "/maps", std::size_t(-1));
     if (maps.empty() || maps.size() > 16) r.fail(at + "/maps", "must list 1 to 16 payloads");

@@ -1,0 +1,342 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// lumx/apl/point_sources.h — a rayset whose every line passes through one of a few points: point sources
+// behind apertures, built as masked APLs (the builder's last step, apl/builder.h step 7).
+//
+// Point sources in an opaque box with holes (an LED behind a shutter, a lamp behind a louvre) light sets
+// of directions with perfectly sharp borders. No texel map reads such a border well at any resolution a
+// bundle can afford: noise-free maps at the two sources of the box with holes stay above 10 % off at
+// some distance up to R 1024 (docs/apl_sets.md, "What maps can do on the box at all"). And clustering
+// puts APLs between the sources, whose rays mix both (step 1b: the lines' points nearest a convergence
+// point between the sources). When every ray's line passes through one of a few points, the light is
+// that of point sources, so:
+//   1. the sources are the positions of the built set's finest level (step 6 placed most of its APLs on
+//      them) through which at least `min_rays` lines pass within `tolerance` of the bounding radius,
+//      on the side the rays leave from (the source is behind, or at, each ray's start);
+//   2. every ray goes to the source its line passes nearest; when one passes none, there are no point
+//      sources and the built set stands;
+//   3. each source moves to its own rays' least-squares point (LineFit), and its directions become its
+//      DirectionMask (math/direction_mask.h); a source whose directions form no mask (light leaving in
+//      every direction) leaves the built set standing;
+//   4. the levels are cuts of a cluster tree over the sources (eq. 4.1), as many APLs as requested but
+//      at most one per source: a box with two sources gets levels of 1 and 2 APLs. An APL of one source
+//      sits at it with its mask; an APL of several at their rays' least-squares point with a plain map
+//      (the box's one-APL level, masked by the hull of all its directions, was 131/85/57/52 % off at
+//      d = 1/2/5/10, plain 126/75/51/53 %: one point cannot stand for sources 4 cm apart);
+//   5. maps are the rays binned as in the builder (step 5), each ray to its source's APL in every level.
+// Masked APLs add up exactly as the lights they stand for: APLs at one point with one mask are one light,
+// so one APL per source is the level (the placement study in docs/apl_sets.md left 303 of 512 APLs
+// empty and equalled the two-APL rows to 0.01 points).
+//
+// Cost: one pass over the rays to count the lines through each candidate, which ends at the first ray
+// that passes none (for any extended emitter, almost always the first), a second to assign the rays, a
+// third to bin them. Memory: the directions of every ray (24 bytes each) while the masks are made.
+#pragma once
+
+#include <lumx/apl/apl_set.h>
+#include <lumx/apl/clustering.h>
+#include <lumx/math/detail/parallel_jobs.h>
+#include <lumx/math/direction_mask.h>
+#include <lumx/math/line_fit.h>
+#include <lumx/rays/rayset.h>
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <vector>
+
+LUMX_NAMESPACE_BEGIN
+
+struct PointSourceOptions {
+  bool enabled = true;           ///< look for point sources at all (AplBuildOptions::point_sources)
+  /// A line passes through a point when it passes within this fraction of the bounding radius of it:
+  /// 1/1000 (70 µm on the 10 cm box with holes, whose rays pass their sources to 10⁻⁸ m, float rounding).
+  double tolerance = 1e-3;
+  std::size_t min_rays = 500;    ///< lines a point needs to be a source (a DirectionMask needs ≥ 64 per beam)
+  std::size_t max_sources = 64;  ///< more points than this: not "a few point sources"
+};
+
+/// What the point-source step found: the sources, or why there are none.
+struct PointSourceReport {
+  std::size_t sources = 0;  ///< 0: the built set stands
+  std::string why;          ///< with no sources: the reason
+};
+
+namespace detail {
+/// m: the distance from c to the line through o along unit w, and whether c lies behind o (or within
+/// `tolerance` ahead of it): a ray leaves its source, so the source is behind its start.
+inline bool line_passes(const glm::dvec3& c, const glm::dvec3& o, const glm::dvec3& w, double tolerance, double& distance) {
+  const glm::dvec3 v = c - o;
+  const double along = glm::dot(v, w);
+  distance = glm::length(v - along * w);
+  return along <= tolerance && distance <= tolerance;
+}
+
+/// Reads every ray of `rays` in chunks, calling per(i, index, chunk) on up to `threads` threads for each
+/// ray of a chunk (i: in the chunk, index: in the file), then after(chunk, first_index) on this thread.
+template <class PerRay, class After>
+void for_each_ray_chunk(RaySource& rays, std::size_t chunk_rays, unsigned threads, PerRay&& per, After&& after) {
+  RayChunk chunk;
+  std::uint64_t first = 0;
+  rays.rewind();
+  while (rays.next(chunk, chunk_rays)) {
+    const std::size_t n = chunk.size(), jobs = std::min<std::size_t>(n, 16);
+    parallel_jobs(jobs, threads, [&](std::size_t j) {
+      for (std::size_t i = n * j / jobs; i < n * (j + 1) / jobs; ++i) per(i, first + i, chunk);
+    });
+    if (!after(chunk, first)) return;
+    first += n;
+  }
+}
+}  // namespace detail
+
+/// The point-source set of `rays` (module comment), or nothing, with the reason in report.why.
+/// `candidates`: the built set's finest positions; `bounds`: its bounding sphere; `level_counts`: the
+/// requested APLs per level (increasing); `resolution(apls)`: the map resolution of a level of that many
+/// APLs; `frame`: the maps' frame. Rays are read `chunk_rays` at a time (each chunk at most that many).
+/// Deterministic: rays are classified independently on `threads` threads and summed in file order.
+inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::vector<glm::vec3>& candidates,
+                                                    const BoundingSphere& bounds, const std::vector<std::size_t>& level_counts,
+                                                    const std::function<int(std::size_t)>& resolution, const MapFrame& frame,
+                                                    const PointSourceOptions& options, std::size_t chunk_rays = 1 << 16,
+                                                    unsigned threads = 1, PointSourceReport* report = nullptr) {
+  PointSourceReport local;
+  PointSourceReport& rep = report ? *report : local;
+  rep = PointSourceReport{};
+  auto none = [&](const std::string& why) -> std::optional<AplSet> {
+    rep.why = why;
+    return std::nullopt;
+  };
+  if (!options.enabled) return none("not looked for");
+  if (level_counts.empty() || chunk_rays == 0) return none("no level requested");
+  const double eps = options.tolerance * bounds.radius;
+  if (!(eps > 0) || !std::isfinite(eps)) return none("the bounding sphere has no size");
+  // The candidates, each within 2·eps of an earlier one dropped (many APLs sit on one source).
+  std::vector<glm::dvec3> points;
+  for (const glm::vec3& c : candidates) {
+    bool seen = false;
+    for (const glm::dvec3& q : points) seen = seen || glm::length(q - glm::dvec3(c)) <= 2 * eps;
+    if (!seen) points.emplace_back(c);
+  }
+  const std::size_t P = points.size();
+  if (P == 0) return none("no candidate point");
+
+  // ---- 1. the lines through each candidate; stops at the first ray (with flux) through none
+  std::vector<std::uint64_t> through(P, 0);
+  std::vector<std::uint8_t> hits(chunk_rays * P), passes_none(chunk_rays);
+  std::uint64_t missing = UINT64_MAX;
+  detail::for_each_ray_chunk(
+      rays, chunk_rays, threads,
+      [&](std::size_t i, std::uint64_t, const RayChunk& c) {
+        const glm::dvec3 o(c.position(i)), w(c.direction(i));
+        bool any = !(c.flux[i] > 0);  // a ray without flux needs no source
+        for (std::size_t p = 0; p < P; ++p) {
+          double d;
+          hits[i * P + p] = c.flux[i] > 0 && detail::line_passes(points[p], o, w, eps, d);
+          any = any || hits[i * P + p];
+        }
+        passes_none[i] = !any;
+      },
+      [&](const RayChunk& c, std::uint64_t first) {
+        for (std::size_t i = 0; i < c.size(); ++i) {
+          if (passes_none[i]) {
+            missing = first + i;
+            return false;
+          }
+          for (std::size_t p = 0; p < P; ++p) through[p] += hits[i * P + p];
+        }
+        return true;
+      });
+  if (missing != UINT64_MAX)
+    return none("ray " + std::to_string(missing) + "'s line passes none of the " + std::to_string(P) +
+                " candidate points");
+  // Most lines first (ties: the earlier candidate); a candidate within 4·eps of one kept is that source
+  // seen off its centre (a point 1.5·eps from a source passes most of its lines within eps) and is dropped.
+  std::vector<std::size_t> order(P);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return through[a] > through[b]; });
+  std::vector<glm::dvec3> sources;
+  for (std::size_t p : order) {
+    if (through[p] < options.min_rays) break;
+    bool near = false;
+    for (const glm::dvec3& q : sources) near = near || glm::length(q - points[p]) <= 4 * eps;
+    if (!near) sources.push_back(points[p]);
+  }
+  if (sources.empty()) return none("no point has " + std::to_string(options.min_rays) + " lines through it");
+  if (sources.size() > options.max_sources)
+    return none(std::to_string(sources.size()) + " points have lines through them (at most " +
+                std::to_string(options.max_sources) + ")");
+
+  // ---- 2. every ray to the source its line passes nearest (the first of equals)
+  const std::size_t S = sources.size();
+  constexpr std::uint32_t kNoSource = UINT32_MAX;
+  std::vector<std::uint32_t> source_of;  // per ray of the file; kNoSource for a ray without flux
+  std::vector<std::uint32_t> chunk_source(chunk_rays);
+  std::vector<LineFit> lines(S);
+  std::vector<std::vector<glm::dvec3>> directions(S);
+  std::vector<double> source_flux(S, 0.0);
+  detail::for_each_ray_chunk(
+      rays, chunk_rays, threads,
+      [&](std::size_t i, std::uint64_t, const RayChunk& c) {
+        chunk_source[i] = kNoSource;
+        if (!(c.flux[i] > 0)) return;
+        const glm::dvec3 o(c.position(i)), w(c.direction(i));
+        double best = INFINITY;
+        for (std::size_t s = 0; s < S; ++s) {
+          double d;
+          if (detail::line_passes(sources[s], o, w, eps, d) && d < best) best = d, chunk_source[i] = std::uint32_t(s);
+        }
+      },
+      [&](const RayChunk& c, std::uint64_t first) {
+        for (std::size_t i = 0; i < c.size(); ++i) {
+          const std::uint32_t s = chunk_source[i];
+          if (s == kNoSource && c.flux[i] > 0) {
+            missing = first + i;
+            return false;
+          }
+          source_of.push_back(s);
+          if (s == kNoSource) continue;
+          lines[s].add(c.position(i), c.direction(i), c.flux[i]);
+          directions[s].push_back(glm::normalize(glm::dvec3(c.direction(i))));
+          source_flux[s] += double(c.flux[i]);
+        }
+        return true;
+      });
+  if (missing != UINT64_MAX)
+    return none("ray " + std::to_string(missing) + "'s line passes none of the " + std::to_string(S) + " sources");
+
+  // ---- 3. each source at its rays' least-squares point (kept where that stays within eps), its mask
+  std::vector<std::shared_ptr<const DirectionMask>> masks(S);
+  for (std::size_t s = 0; s < S; ++s)
+    if (directions[s].size() < options.min_rays)
+      return none("source " + std::to_string(s) + " is the nearest of only " + std::to_string(directions[s].size()) + " lines");
+  for (std::size_t s = 0; s < S; ++s) {
+    const glm::dvec3 x = lines[s].solve(sources[s], 1e-9);
+    if (glm::length(x - sources[s]) <= eps) sources[s] = x;
+    std::string why;
+    std::optional<DirectionMask> m = DirectionMask::from_directions(directions[s], {}, &why);
+    if (!m) return none("source " + std::to_string(s) + ": " + why);
+    masks[s] = std::make_shared<const DirectionMask>(std::move(*m));
+  }
+
+  // ---- 4. levels: cuts of a tree over the sources, at most one APL per source
+  std::vector<std::size_t> counts;
+  for (std::size_t c : level_counts) {
+    const std::size_t n = std::min(c, S);
+    if (counts.empty() || n > counts.back()) counts.push_back(n);
+  }
+  std::vector<std::vector<std::uint32_t>> apl_of(counts.size(), std::vector<std::uint32_t>(S));  // per level, source → APL
+  {
+    std::vector<glm::vec3> pos;
+    std::vector<float> flux;
+    for (std::size_t s = 0; s < S; ++s) pos.emplace_back(sources[s]), flux.push_back(float(source_flux[s]));
+    // A tree only where some level has fewer APLs than sources (one source needs none).
+    const ClusterTree tree = counts.front() < S ? build_cluster_tree(pos, flux, ClusterOptions{}) : ClusterTree{};
+    const std::vector<std::vector<int>> cuts = counts.front() < S ? cut_cluster_tree(tree, counts) : std::vector<std::vector<int>>{};
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+      if (counts[k] == S) {  // one APL per source, in the sources' order
+        for (std::size_t s = 0; s < S; ++s) apl_of[k][s] = std::uint32_t(s);
+        continue;
+      }
+      if (k >= cuts.size() || cuts[k].size() != counts[k]) return none("the sources' tree gives no cut of " + std::to_string(counts[k]));
+      for (std::size_t i = 0; i < cuts[k].size(); ++i) {
+        std::vector<int> stack{cuts[k][i]};  // label the sources below the cut node
+        while (!stack.empty()) {
+          const int node = stack.back();
+          stack.pop_back();
+          if (tree.is_seed(node)) {
+            apl_of[k][std::size_t(node)] = std::uint32_t(i);
+          } else {
+            stack.push_back(tree.left[std::size_t(node)]);
+            stack.push_back(tree.right[std::size_t(node)]);
+          }
+        }
+      }
+    }
+  }
+  AplSet set;
+  set.bounds = bounds;
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    AplLevel level;
+    level.frame = frame;
+    level.map_resolution = resolution(counts[k]);
+    level.apls.resize(counts[k]);
+    std::vector<std::vector<std::size_t>> members(counts[k]);
+    for (std::size_t s = 0; s < S; ++s) members[apl_of[k][s]].push_back(s);
+    for (std::size_t a = 0; a < counts[k]; ++a) {
+      Apl& apl = level.apls[a];
+      const std::vector<std::size_t>& mine = members[a];
+      if (mine.empty()) continue;  // check_apl_set reports it; a cut of the tree has none
+      apl.parent = k == 0 ? -1 : int(apl_of[k - 1][mine.front()]);
+      if (mine.size() == 1) {
+        apl.position = glm::vec3(sources[mine.front()]);
+        apl.mask = masks[mine.front()];
+        continue;
+      }
+      LineFit all;
+      glm::dvec3 mean(0.0);
+      double weight = 0;
+      for (std::size_t s : mine) {
+        all.add(lines[s]);
+        mean += source_flux[s] * sources[s], weight += source_flux[s];
+      }
+      mean = weight > 0 ? mean / weight : sources[mine.front()];
+      const glm::dvec3 x = all.solve(mean, sphere_map::texel_solid_angle(level.map_resolution));
+      apl.position = glm::vec3(glm::length(x - bounds.center) <= 1.001 * bounds.radius + 1e-9 ? x : mean);
+    }
+    set.levels.push_back(std::move(level));
+  }
+  std::vector<std::vector<glm::dvec3>>().swap(directions);
+
+  // ---- 5. maps: each ray's flux, as intensity, in its source's APL of every level (file order)
+  std::vector<std::vector<double>> sums(set.levels.size());
+  for (std::size_t k = 0; k < set.levels.size(); ++k)
+    sums[k].assign(set.levels[k].apls.size() * 2 * std::size_t(set.levels[k].map_resolution) *
+                       std::size_t(set.levels[k].map_resolution), 0.0);
+  {
+    RayChunk c;
+    std::uint64_t index = 0;
+    rays.rewind();
+    while (rays.next(c, chunk_rays))
+      for (std::size_t i = 0; i < c.size(); ++i, ++index) {
+        const std::uint32_t s = index < source_of.size() ? source_of[index] : kNoSource;
+        if (s == kNoSource) continue;
+        const glm::vec3 m = frame.map_direction(c.direction(i));
+        for (std::size_t k = 0; k < set.levels.size(); ++k) {
+          const int R = set.levels[k].map_resolution;
+          int x, y;
+          sphere_map::texel_of(m, R, x, y);
+          sums[k][std::size_t(apl_of[k][s]) * 2 * std::size_t(R) * std::size_t(R) + std::size_t(y) * 2 * std::size_t(R) +
+                  std::size_t(x)] += double(c.flux[i]);
+        }
+      }
+  }
+  for (std::size_t k = 0; k < set.levels.size(); ++k) {
+    AplLevel& level = set.levels[k];
+    const int R = level.map_resolution;
+    const std::size_t T = 2 * std::size_t(R) * std::size_t(R);
+    const double to_intensity = 1.0 / sphere_map::texel_solid_angle(R);
+    for (std::size_t a = 0; a < level.apls.size(); ++a) {
+      Apl& apl = level.apls[a];
+      apl.map = SphereMap(R, 1);
+      double flux = 0;
+      for (std::size_t t = 0; t < T; ++t) {
+        apl.map.values()[t] = float(sums[k][a * T + t] * to_intensity);
+        flux += sums[k][a * T + t];
+      }
+      apl.flux = glm::dvec3(flux);
+      refresh_coverage(apl, level.frame);
+    }
+  }
+  rep.sources = S;
+  return set;
+}
+
+LUMX_NAMESPACE_END

@@ -1,0 +1,293 @@
+// SPDX-License-Identifier: Apache-2.0
+// Copyright Contributors to the lumx project.
+// Point sources behind apertures as masked APLs (lumx/apl/point_sources.h, the builder's step 7): found
+// where every line passes through a few points and nowhere else, placed at the sources, their masks in
+// evaluation, sampling and the bundle, and the bundle's refusals of bad masks.
+#include <lumx/apl/builder.h>
+#include <lumx/apl/error.h>
+#include <lumx/apl/evaluation.h>
+#include <lumx/apl/sampling.h>
+#include <lumx/io/bundle_io.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "analytic_emitters.h"
+#include "test_support.h"
+
+#include <algorithm>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <sstream>
+
+using namespace lumx;
+using namespace lumx_test;
+
+namespace {
+
+// The suite's box with holes (test_apl_honest_error.cpp): two isotropic point sources in a 10 cm box.
+PinholeBox two_source_box() {
+  using H = PinholeBox::Hole;
+  return {"two point sources in a 10 cm box with four holes", 0.05,
+          {H{2, 1, -0.03, 0.01, -0.02, 0.03}, H{2, -1, 0.0, 0.03, -0.03, 0.0}, H{0, 1, -0.04, -0.01, -0.01, 0.03},
+           H{1, -1, -0.02, 0.02, -0.045, -0.02}},
+          {{{-0.02, 0.01, 0.0}, 500}, {{0.015, -0.01, 0.01}, 500}}};
+}
+const glm::dvec3 kSources[2] = {{-0.02, 0.01, 0.0}, {0.015, -0.01, 0.01}};
+
+double ray_flux(RaySource& rays) {
+  RayChunk c;
+  double f = 0;
+  rays.rewind();
+  while (rays.next(c, 1 << 16))
+    for (float x : c.flux) f += x;
+  return f;
+}
+
+void write_text(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+}
+
+}  // namespace
+
+TEST(PointSources, TheBoxWithHolesBecomesOneMaskedAplPerSource) {
+  const PinholeBox box = two_source_box();
+  auto rays = box.source(kSanitized ? 200000 : 1000000, 21);
+  AplBuildOptions bo;
+  bo.threads = 2;
+  AplBuildReport rep;
+  const AplSet set = build_apl_set(*rays, bo, &rep);
+  ASSERT_EQ(rep.point_sources, 2u) << rep.point_source_note;
+  // Levels 1, 8, 64, 256, 512 requested; at most one APL per source: 1 and 2.
+  ASSERT_EQ(set.levels.size(), 2u);
+  EXPECT_EQ(set.levels[0].size(), 1u);
+  ASSERT_EQ(set.levels[1].size(), 2u);
+  EXPECT_TRUE(check_apl_set(set).empty());
+  // Each finest APL sits on a source: the rays' lines pass the sources to float rounding (10⁻⁸ m here),
+  // far below the 70 µm tolerance they were gathered with.
+  for (const Apl& a : set.levels[1].apls) {
+    const double d = std::min(glm::length(glm::dvec3(a.position) - kSources[0]), glm::length(glm::dvec3(a.position) - kSources[1]));
+    EXPECT_LT(d, 1e-6) << "APL at " << a.position.x << ", " << a.position.y << ", " << a.position.z;
+    ASSERT_TRUE(a.mask);
+    EXPECT_EQ(a.mask->caps().size(), 4u);  // four holes let each source out
+    EXPECT_EQ(a.coverage.resolution(), a.map.resolution());
+    EXPECT_EQ(a.parent, 0);
+  }
+  EXPECT_NE(glm::length(set.levels[1].apls[0].position - set.levels[1].apls[1].position), 0.0f);
+  // Every ray's flux is in every level (the two sources share the flux about equally).
+  const double total = ray_flux(*rays);
+  for (const AplLevel& l : set.levels) EXPECT_NEAR(l.flux().x, total, 1e-6 * total);
+  // Each APL holds the flux of the rays whose lines pass its source (to 10⁻⁵ m here, independently).
+  {
+    RayChunk c;
+    double through[2] = {0, 0};
+    rays->rewind();
+    while (rays->next(c, 1 << 16))
+      for (std::size_t i = 0; i < c.size(); ++i)
+        for (const Apl& apl : set.levels[1].apls) {
+          const glm::dvec3 v = glm::dvec3(apl.position) - glm::dvec3(c.position(i)), w(c.direction(i));
+          if (glm::length(v - glm::dot(v, w) * w) < 1e-5) through[&apl - &set.levels[1].apls[0]] += c.flux[i];
+        }
+    for (int i = 0; i < 2; ++i) EXPECT_NEAR(set.levels[1].apls[i].flux.x, through[i], 1e-6 * total);
+  }
+  // A direction through no hole is dark, one through a hole lit, from the source's own position.
+  const Apl& a = set.levels[1].apls[0];
+  const bool first_is_0 = glm::length(glm::dvec3(a.position) - kSources[0]) < 1e-6;
+  const glm::dvec3 src = first_is_0 ? kSources[0] : kSources[1];
+  const glm::dvec3 through_top = glm::normalize(glm::dvec3(-0.01, 0.005, 0.05) - src);  // hole on +z
+  const glm::dvec3 into_wall = glm::normalize(glm::dvec3(0.0, 0.05, 0.0) - src);         // +y face: no hole
+  EXPECT_GT(intensity(set.levels[1], a, glm::vec3(through_top)).x, 0.0f);
+  EXPECT_EQ(intensity(set.levels[1], a, glm::vec3(into_wall)).x, 0.0f);
+}
+
+TEST(PointSources, ExtendedEmittersKeepTheClusteredSet) {
+  const PlanarEmitter disk{"Lambertian disk r = 0.1 m", PlanarEmitter::Shape::disk, 0.1, 0, 1, 1000};
+  auto rays = disk.source(20000, 3);
+  AplBuildOptions bo;
+  bo.level_counts = {1, 8, 64};
+  AplBuildReport rep;
+  const AplSet set = build_apl_set(*rays, bo, &rep);
+  EXPECT_EQ(rep.point_sources, 0u);
+  EXPECT_NE(rep.point_source_note.find("passes none"), std::string::npos) << rep.point_source_note;
+  ASSERT_EQ(set.levels.size(), 3u);
+  for (const AplLevel& l : set.levels) EXPECT_FALSE(l.has_masks());
+  // Off by option: the same set as found none.
+  bo.point_sources.enabled = false;
+  const AplSet off = build_apl_set(*rays, bo);
+  ASSERT_EQ(off.levels.size(), set.levels.size());
+  for (std::size_t k = 0; k < set.levels.size(); ++k)
+    for (std::size_t i = 0; i < set.levels[k].size(); ++i)
+      EXPECT_EQ(off.levels[k].apls[i].map.values(), set.levels[k].apls[i].map.values());
+}
+
+TEST(PointSources, AFewStrayLinesLeaveTheClusteredSet) {
+  // One ray in 10 000 not through a source (a reflection off the box's edge, say): no point-source set,
+  // since its light would have no APL to leave from.
+  const PinholeBox box = two_source_box();
+  RayChunk c = box.rays(200000, 5);
+  for (std::size_t i = 0; i < c.size(); i += 10000) c.x[i] += 0.003f;
+  RaysetInfo info;
+  info.file = "box with stray rays";
+  MemoryRaySource rays(std::move(c), info);
+  AplBuildReport rep;
+  const AplSet set = build_apl_set(rays, AplBuildOptions{}, &rep);
+  EXPECT_EQ(rep.point_sources, 0u);
+  EXPECT_FALSE(set.levels.back().has_masks());
+}
+
+TEST(PointSources, TheSameSetForAnyThreadCount) {
+  const PinholeBox box = two_source_box();
+  auto rays = box.source(300000, 8);
+  AplBuildOptions one, two;
+  one.threads = 1, two.threads = 2;
+  one.chunk_rays = 5000;  // other chunks too
+  const AplSet a = build_apl_set(*rays, one), b = build_apl_set(*rays, two);
+  ASSERT_EQ(a.levels.size(), b.levels.size());
+  for (std::size_t k = 0; k < a.levels.size(); ++k)
+    for (std::size_t i = 0; i < a.levels[k].size(); ++i) {
+      EXPECT_EQ(a.levels[k].apls[i].position, b.levels[k].apls[i].position);
+      EXPECT_EQ(a.levels[k].apls[i].map.values(), b.levels[k].apls[i].map.values());
+      EXPECT_EQ(a.levels[k].apls[i].coverage.values(), b.levels[k].apls[i].coverage.values());
+    }
+}
+
+TEST(PointSources, MaskedEmissionSamplesAreUnbiased) {
+  // E[sample flux] = ∫ I(ω) dω, the masked intensity's integral, computed here by quadrature over 64 × 64
+  // sub-directions per texel of R 32 (no sampling). Each sample's flux is I(ω)/pdf: 0 outside the mask.
+  const PinholeBox box = two_source_box();
+  auto rays = box.source(400000, 9);
+  AplBuildOptions bo;
+  bo.map_resolution = 16;
+  AplBuildReport rep;
+  const AplSet set = build_apl_set(*rays, bo, &rep);
+  ASSERT_EQ(set.levels.size(), 2u) << rep.point_source_note;
+  const AplLevel& level = set.levels[1];
+  double exact = 0;
+  const int R = 32, sub = 16;
+  const double dw = sphere_map::texel_solid_angle(R) / (sub * sub);
+  for (std::size_t i = 0; i < level.size(); ++i)
+    for (int y = 0; y < R * sub; ++y)
+      for (int x = 0; x < 2 * R * sub; ++x) {
+        const glm::vec2 uv((float(x) + 0.5f) / float(2 * R * sub), (float(y) + 0.5f) / float(R * sub));
+        const glm::vec3 w = level.frame.world_direction(sphere_map::uv_to_direction(uv));
+        exact += double(intensity(level, level.apls[i], glm::normalize(w)).x) * dw;
+      }
+  AplEmissionSampler sampler(set, 1);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const int n = 400000;
+  double sum = 0, sum2 = 0;
+  int outside = 0;
+  for (int s = 0; s < n; ++s) {
+    const EmissionSample e = sampler.sample(u(rng), u(rng), u(rng));
+    ASSERT_TRUE(e.valid());
+    EXPECT_FLOAT_EQ(sampler.pdf(e.apl, e.direction), e.pdf_apl * e.pdf_direction);
+    sum += e.flux.x, sum2 += double(e.flux.x) * e.flux.x;
+    outside += e.flux.x == 0;
+  }
+  const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
+  std::printf("masked emission: mean sample flux %.3f lm ± %.3f, quadrature %.3f lm, %.1f %% of samples outside the masks; "
+              "the maps hold %.3f lm\n", mean, se, exact, 100.0 * outside / n, level.flux().x);
+  EXPECT_NEAR(mean, exact, 4 * se);
+  // The masked intensity keeps the maps' flux to the coverage's sampling: within 1 % here.
+  EXPECT_NEAR(exact, level.flux().x, 0.01 * level.flux().x);
+}
+
+TEST(PointSources, MasksRoundTripThroughTheBundle) {
+  const PinholeBox box = two_source_box();
+  auto rays = box.source(200000, 12);
+  AplBuildOptions bo;
+  bo.map_resolution = 32;
+  const AplSet set = build_apl_set(*rays, bo);
+  ASSERT_TRUE(set.levels.back().has_masks());
+  const auto dir = fresh_temp_dir("point_sources_bundle");
+  write_bundle((dir / "b.lumx").string(), set);
+  const std::string manifest = read_text(dir / "b.lumx" / "manifest.json");
+  const nlohmann::json doc = nlohmann::json::parse(manifest);
+  EXPECT_EQ(doc["format_version"], 3);
+  EXPECT_EQ(doc["masks"].size(), 2u);  // the two sources' (level 0's one APL stands for both: plain)
+  const BundleReader reader((dir / "b.lumx").string());
+  const AplSet back = reader.load();
+  ASSERT_EQ(back.levels.size(), set.levels.size());
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (std::size_t k = 0; k < set.levels.size(); ++k) {
+    for (std::size_t i = 0; i < set.levels[k].size(); ++i) {
+      ASSERT_EQ(bool(back.levels[k].apls[i].mask), bool(set.levels[k].apls[i].mask));
+      if (!set.levels[k].apls[i].mask) continue;
+      const auto& ca = set.levels[k].apls[i].mask->caps();
+      const auto& cb = back.levels[k].apls[i].mask->caps();
+      ASSERT_EQ(ca.size(), cb.size());
+      for (std::size_t c = 0; c < ca.size(); ++c) EXPECT_EQ(ca[c].hull, cb[c].hull);  // doubles round-trip JSON
+      EXPECT_EQ(back.levels[k].apls[i].coverage.values(), set.levels[k].apls[i].coverage.values());
+    }
+    // The same irradiance at points around the box (maps in half floats: to 2^-11 relative).
+    for (int p = 0; p < 200; ++p) {
+      const glm::vec3 x = 0.3f * glm::normalize(glm::vec3(u(rng), u(rng), u(rng)));
+      const double e0 = irradiance(set, k, x, -glm::normalize(x)).irradiance.x;
+      const double e1 = irradiance(back, k, x, -glm::normalize(x)).irradiance.x;
+      EXPECT_NEAR(e1, e0, 1e-3 * e0 + 1e-9);
+    }
+  }
+  // Partial loading at a coarser resolution recomputes the coverage there.
+  const AplLevel coarse = reader.load_level(1, 8);
+  EXPECT_EQ(coarse.apls[0].coverage.resolution(), 8);
+  EXPECT_TRUE(check_bundle((dir / "b.lumx").string()).empty());
+  // A set without masks is still format version 2.
+  AplBuildOptions plain = bo;
+  plain.point_sources.enabled = false;
+  write_bundle((dir / "p.lumx").string(), build_apl_set(*rays, plain));
+  EXPECT_EQ(nlohmann::json::parse(read_text(dir / "p.lumx" / "manifest.json"))["format_version"], 2);
+
+  // Bad masks are refused with the JSON pointer of the field and what is wrong.
+  const auto refused = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& pointer,
+                           const std::string& says) {
+    nlohmann::json bad = doc;
+    edit(bad);
+    write_text(dir / "b.lumx" / "manifest.json", bad.dump(1));
+    try {
+      BundleReader r((dir / "b.lumx").string());
+      ADD_FAILURE() << "accepted: " << pointer << " " << says;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(pointer), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  using J = nlohmann::json;
+  refused([](J& j) { j["levels"][1]["mask"][0] = 7; }, "/levels/1/mask/0", "exceeds 1");
+  refused([](J& j) { j["format_version"] = 2; }, "/masks", "not part of format version 2");
+  refused([](J& j) { j["masks"][0]["caps"][0]["hull"][0] = J::array({1.0, 2.0, 3.0}); }, "/masks/0/caps/0/hull/0",
+          "expected 2");
+  refused([](J& j) { j["masks"][0]["caps"] = J::array(); }, "/masks/0/caps", "0 caps");
+  refused([](J& j) { j["masks"][0]["caps"][0]["axis"] = J::array({2.0, 0.0, 0.0}); }, "/masks/0", "orthonormal");
+  refused([](J& j) { j["masks"][0]["caps"][0]["extra"] = 1; }, "/masks/0/caps/0", "extra");
+  refused([](J& j) { j["masks"][0]["caps"][0]["hull"][1][0] = nullptr; }, "/masks/0/caps/0/hull/1/0", "number");
+  refused(
+      [](J& j) {
+        J& h = j["masks"][0]["caps"][0]["hull"];
+        std::reverse(h.begin(), h.end());  // clockwise
+      },
+      "/masks/0", "counter-clockwise");
+}
+
+TEST(PointSources, FromCapsRefusesWhatIsNoConvexHull) {
+  DirectionMask::Cap c;
+  c.hull = {{0, 0}, {0.1, 0}, {0.1, 0.1}, {0, 0.1}};
+  EXPECT_NO_THROW(DirectionMask::from_caps({c}));
+  DirectionMask::Cap twice = c;  // a pentagram: every turn left, yet twice around
+  twice.hull = {{1, 0}, {-0.809, 0.588}, {0.309, -0.951}, {0.309, 0.951}, {-0.809, -0.588}};
+  for (auto& p : twice.hull) p *= 0.1;
+  EXPECT_THROW(DirectionMask::from_caps({twice}), std::invalid_argument);
+  DirectionMask::Cap skew = c;
+  skew.e1 = glm::dvec3(1, 0.01, 0);
+  EXPECT_THROW(DirectionMask::from_caps({skew}), std::invalid_argument);
+  DirectionMask::Cap nan = c;
+  nan.hull[2].x = NAN;
+  EXPECT_THROW(DirectionMask::from_caps({nan}), std::invalid_argument);
+  DirectionMask::Cap wide = c;
+  for (auto& p : wide.hull) p *= 100.0;  // reaches 1.56 rad from its axis
+  EXPECT_THROW(DirectionMask::from_caps({wide}), std::invalid_argument);
+  EXPECT_THROW(DirectionMask::from_caps({}), std::invalid_argument);
+}
