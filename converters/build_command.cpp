@@ -85,6 +85,10 @@ void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lu
     }
     std::printf("\n          clustered by %s; %zu APLs at their rays' convergence point\n",
                 br.slid_to_convergence ? "line" : "start point", br.moved_to_convergence);
+    if (br.point_sources > 0)
+      std::printf("point sources: %zu; every ray's line passes through one: one masked APL per source (beam borders "
+                  "as geometry)\n",
+                  br.point_sources);
   }
   if (r.error_tables_stored && r.held_out.fitted) {
     std::printf("maps:     resolutions chosen on held-out rays:");

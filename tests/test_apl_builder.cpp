@@ -446,6 +446,19 @@ TEST(AplBuilder, ConvergencePlacementFindsAnEnclosedEmitter) {
   o.place_at_convergence = false;  // the dissertation's rule: APLs at their seeds' box centres
   const AplErrorReport on_caps = evaluate_apl_errors(build_apl_set(rays, o), rays, eo);
   o.place_at_convergence = true;
+  // Every line passes through the origin, and the rays leave it in two cones: a point source behind
+  // two apertures, which step 7 builds as one masked APL there (apl/point_sources.h).
+  {
+    AplBuildReport found;
+    const AplSet point = build_apl_set(rays, o, &found);
+    EXPECT_EQ(found.point_sources, 1u) << found.point_source_note;
+    ASSERT_EQ(point.levels.size(), 1u);
+    ASSERT_EQ(point.levels[0].size(), 1u);
+    EXPECT_LT(glm::length(point.levels[0].apls[0].position), 1e-6f);
+    ASSERT_TRUE(point.levels[0].apls[0].mask);
+    EXPECT_EQ(point.levels[0].apls[0].mask->caps().size(), 2u);
+  }
+  o.point_sources.enabled = false;  // step 6's placement, which this test is about
   AplBuildReport report;
   const AplSet moved = build_apl_set(rays, o, &report);
   EXPECT_EQ(report.moved_to_convergence, 9u);

@@ -143,3 +143,29 @@ TEST(CliBuild, MaxResolutionCapsEveryLevelsMaps) {
             0);
   fs::remove_all(dir);
 }
+
+TEST(CliBuild, PointSourcesBehindAperturesShipAsMaskedApls) {
+  // The analytic suite's box with holes as a TM-25 file: lumx build finds the two point sources, says
+  // so, and ships one masked APL per source in a format-3 bundle that lumx check accepts.
+  const fs::path dir = lumx_test::fresh_temp_dir("lumx_cli_build_box");
+  using H = lumx_test::PinholeBox::Hole;
+  const lumx_test::PinholeBox box("box", 0.05,
+                                  {H{2, 1, -0.03, 0.01, -0.02, 0.03}, H{2, -1, 0.0, 0.03, -0.03, 0.0},
+                                   H{0, 1, -0.04, -0.01, -0.01, 0.03}, H{1, -1, -0.02, 0.02, -0.045, -0.02}},
+                                  {{{-0.02, 0.01, 0.0}, 500}, {{0.015, -0.01, 0.01}, 500}});
+  auto src = box.source(lumx_test::kSanitized ? 200000 : 400000, 3);
+  write_tm25((dir / "box.tm25ray").string(), src->info(), *src);
+  const lumx_test::CliRun r =
+      lumx_test::run_cli("build " + lumx_test::quoted(dir / "box.tm25ray") + " " + lumx_test::quoted(dir / "b"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(has(r.out, "point sources: 2;")) << r.out;
+  const BundleReader bundle((dir / "b").string());
+  EXPECT_EQ(bundle.manifest().format_version, 3);
+  ASSERT_EQ(bundle.manifest().levels.size(), 2u);
+  EXPECT_EQ(bundle.manifest().masks.size(), 2u);
+  const AplSet set = bundle.load();
+  for (const Apl& a : set.levels[1].apls) EXPECT_TRUE(a.mask);
+  const lumx_test::CliRun check = lumx_test::run_cli("check " + lumx_test::quoted(dir / "b"));
+  EXPECT_EQ(check.status, 0) << check.out;
+  fs::remove_all(dir);
+}

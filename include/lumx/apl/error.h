@@ -1457,6 +1457,16 @@ inline AplSet centring_pilot(const AplSet& set, double sigma) {
   pilot.levels.push_back(set.levels[best]);
   auto texel = [](int R) { return std::sqrt(4.0 * kPi / (2.0 * double(R) * double(R))); };
   int R = pilot.levels[0].map_resolution;
+  // A masked level (point sources behind apertures) already has its borders as geometry: its pilot is
+  // its maps unsmoothed (a kernel would blur what the mask divides by its coverage), halved to R 8 at most
+  // for their noise. On the box with holes this brought the masked level's estimate from 19-30 % to
+  // 7-24 % (its point error 2.7-3.2 %), the same at R 4 and R 16 (docs/apl_sets.md).
+  if (pilot.levels[0].has_masks()) {
+    int to = R;
+    while (to > 8 && to % 2 == 0) to /= 2;
+    if (to != R) pilot.levels[0] = downsampled_level(pilot.levels[0], to);
+    return pilot;
+  }
   if (sigma > 0) {
     const double cut = std::log(1e3) * sigma * sigma;  // 1 − cos of the kernel's truncation (κ = 1/σ²)
     auto too_fine = [&](int r) {

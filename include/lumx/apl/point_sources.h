@@ -29,8 +29,8 @@
 // empty and equalled the two-APL rows to 0.01 points).
 //
 // Cost: one pass over the rays to count the lines through each candidate, which ends at the first ray
-// that passes none (for any extended emitter, almost always the first), a second to assign the rays, a
-// third to bin them. Memory: the directions of every ray (24 bytes each) while the masks are made.
+// that passes none (for any extended emitter, almost always the first: 4 096 rays are read), a second to
+// assign the rays, a third to bin them. Memory: the directions of every ray (24 bytes each) while the masks are made.
 #pragma once
 
 #include <lumx/apl/apl_set.h>
@@ -79,15 +79,18 @@ inline bool line_passes(const glm::dvec3& c, const glm::dvec3& o, const glm::dve
   return along <= tolerance && distance <= tolerance;
 }
 
-/// Reads every ray of `rays` in chunks, calling per(i, index, chunk) on up to `threads` threads for each
-/// ray of a chunk (i: in the chunk, index: in the file), then after(chunk, first_index) on this thread.
-template <class PerRay, class After>
-void for_each_ray_chunk(RaySource& rays, std::size_t chunk_rays, unsigned threads, PerRay&& per, After&& after) {
+/// Reads every ray of `rays` in chunks, calling prepare(n) for a chunk of n rays, per(i, index, chunk) on
+/// up to `threads` threads for each of its rays (i: in the chunk, index: in the file), then
+/// after(chunk, first_index) on this thread, which returns whether to go on.
+template <class Prepare, class PerRay, class After>
+void for_each_ray_chunk(RaySource& rays, std::size_t chunk_rays, unsigned threads, Prepare&& prepare, PerRay&& per,
+                        After&& after) {
   RayChunk chunk;
   std::uint64_t first = 0;
   rays.rewind();
   while (rays.next(chunk, chunk_rays)) {
     const std::size_t n = chunk.size(), jobs = std::min<std::size_t>(n, 16);
+    prepare(n);
     parallel_jobs(jobs, threads, [&](std::size_t j) {
       for (std::size_t i = n * j / jobs; i < n * (j + 1) / jobs; ++i) per(i, first + i, chunk);
     });
@@ -130,10 +133,14 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
 
   // ---- 1. the lines through each candidate; stops at the first ray (with flux) through none
   std::vector<std::uint64_t> through(P, 0);
-  std::vector<std::uint8_t> hits(chunk_rays * P), passes_none(chunk_rays);
+  std::vector<std::uint8_t> hits, passes_none;
   std::uint64_t missing = UINT64_MAX;
+  // Small chunks: an extended emitter's first ray through no candidate ends the pass after 4 096 rays.
   detail::for_each_ray_chunk(
-      rays, chunk_rays, threads,
+      rays, std::min<std::size_t>(chunk_rays, 4096), threads,
+      [&](std::size_t n) {
+        if (passes_none.size() < n) hits.resize(n * P), passes_none.resize(n);
+      },
       [&](std::size_t i, std::uint64_t, const RayChunk& c) {
         const glm::dvec3 o(c.position(i)), w(c.direction(i));
         bool any = !(c.flux[i] > 0);  // a ray without flux needs no source
@@ -174,49 +181,76 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
     return none(std::to_string(sources.size()) + " points have lines through them (at most " +
                 std::to_string(options.max_sources) + ")");
 
-  // ---- 2. every ray to the source its line passes nearest (the first of equals)
-  const std::size_t S = sources.size();
+  // ---- 2. every ray to the source its line passes nearest (the first of equals). A point a few eps
+  // from a source passes some of its lines too (those within eps/δ rad of its direction from the
+  // source), so a point kept in step 1 can be the nearest of few lines or none: such points are dropped
+  // and the rays assigned again, until every source is the nearest of min_rays lines.
   constexpr std::uint32_t kNoSource = UINT32_MAX;
   std::vector<std::uint32_t> source_of;  // per ray of the file; kNoSource for a ray without flux
-  std::vector<std::uint32_t> chunk_source(chunk_rays);
-  std::vector<LineFit> lines(S);
-  std::vector<std::vector<glm::dvec3>> directions(S);
-  std::vector<double> source_flux(S, 0.0);
-  detail::for_each_ray_chunk(
-      rays, chunk_rays, threads,
-      [&](std::size_t i, std::uint64_t, const RayChunk& c) {
-        chunk_source[i] = kNoSource;
-        if (!(c.flux[i] > 0)) return;
-        const glm::dvec3 o(c.position(i)), w(c.direction(i));
-        double best = INFINITY;
-        for (std::size_t s = 0; s < S; ++s) {
-          double d;
-          if (detail::line_passes(sources[s], o, w, eps, d) && d < best) best = d, chunk_source[i] = std::uint32_t(s);
-        }
-      },
-      [&](const RayChunk& c, std::uint64_t first) {
-        for (std::size_t i = 0; i < c.size(); ++i) {
-          const std::uint32_t s = chunk_source[i];
-          if (s == kNoSource && c.flux[i] > 0) {
-            missing = first + i;
-            return false;
+  std::vector<std::uint32_t> chunk_source;
+  std::vector<LineFit> lines;
+  std::vector<std::vector<glm::dvec3>> directions;
+  std::vector<double> source_flux;
+  std::vector<std::uint64_t> nearest_of;
+  const auto assign = [&](bool collect) {
+    const std::size_t n_src = sources.size();
+    nearest_of.assign(n_src, 0);
+    if (collect) {
+      source_of.clear();
+      lines.assign(n_src, LineFit{});
+      directions.assign(n_src, {});
+      source_flux.assign(n_src, 0.0);
+    }
+    detail::for_each_ray_chunk(
+        rays, chunk_rays, threads,
+        [&](std::size_t n) {
+          if (chunk_source.size() < n) chunk_source.resize(n);
+        },
+        [&](std::size_t i, std::uint64_t, const RayChunk& c) {
+          chunk_source[i] = kNoSource;
+          if (!(c.flux[i] > 0)) return;
+          const glm::dvec3 o(c.position(i)), w(c.direction(i));
+          double best = INFINITY;
+          for (std::size_t q = 0; q < n_src; ++q) {
+            double d;
+            if (detail::line_passes(sources[q], o, w, eps, d) && d < best) best = d, chunk_source[i] = std::uint32_t(q);
           }
-          source_of.push_back(s);
-          if (s == kNoSource) continue;
-          lines[s].add(c.position(i), c.direction(i), c.flux[i]);
-          directions[s].push_back(glm::normalize(glm::dvec3(c.direction(i))));
-          source_flux[s] += double(c.flux[i]);
-        }
-        return true;
-      });
-  if (missing != UINT64_MAX)
-    return none("ray " + std::to_string(missing) + "'s line passes none of the " + std::to_string(S) + " sources");
+        },
+        [&](const RayChunk& c, std::uint64_t first) {
+          for (std::size_t i = 0; i < c.size(); ++i) {
+            const std::uint32_t q = chunk_source[i];
+            if (q == kNoSource && c.flux[i] > 0) {
+              missing = first + i;
+              return false;
+            }
+            if (q != kNoSource) ++nearest_of[q];
+            if (!collect) continue;
+            source_of.push_back(q);
+            if (q == kNoSource) continue;
+            lines[q].add(c.position(i), c.direction(i), c.flux[i]);
+            directions[q].push_back(glm::normalize(glm::dvec3(c.direction(i))));
+            source_flux[q] += double(c.flux[i]);
+          }
+          return true;
+        });
+  };
+  while (true) {  // each round drops a point at least, so at most max_sources rounds
+    assign(false);
+    if (missing != UINT64_MAX)
+      return none("ray " + std::to_string(missing) + "'s line passes none of the " + std::to_string(sources.size()) +
+                  " sources");
+    std::vector<glm::dvec3> kept;
+    for (std::size_t q = 0; q < sources.size(); ++q)
+      if (nearest_of[q] >= options.min_rays) kept.push_back(sources[q]);
+    if (kept.size() == sources.size()) break;
+    if (kept.empty()) return none("no set of points is each the nearest of " + std::to_string(options.min_rays) + " lines");
+    sources = std::move(kept);
+  }
+  assign(true);
+  const std::size_t S = sources.size();
 
   // ---- 3. each source at its rays' least-squares point (kept where that stays within eps), its mask
   std::vector<std::shared_ptr<const DirectionMask>> masks(S);
-  for (std::size_t s = 0; s < S; ++s)
-    if (directions[s].size() < options.min_rays)
-      return none("source " + std::to_string(s) + " is the nearest of only " + std::to_string(directions[s].size()) + " lines");
   for (std::size_t s = 0; s < S; ++s) {
     const glm::dvec3 x = lines[s].solve(sources[s], 1e-9);
     if (glm::length(x - sources[s]) <= eps) sources[s] = x;
