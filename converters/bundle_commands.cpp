@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -31,8 +32,14 @@ namespace {
 
 /// Bytes the level's maps take in memory at full resolution (float texels).
 std::uint64_t level_memory_bytes(const lumx::BundleLevelInfo& l, lumx::ChannelLayout c) {
-  return std::uint64_t(l.apl_count()) * 2 * std::uint64_t(l.map_resolution) * l.map_resolution *
-         lumx::channel_count(c) * sizeof(float);
+  const std::uint64_t masked = std::uint64_t(std::count_if(l.mask.begin(), l.mask.end(), [](int i) { return i >= 0; }));
+  return (std::uint64_t(l.apl_count()) * lumx::channel_count(c) + masked) * 2 * std::uint64_t(l.map_resolution) *
+         l.map_resolution * sizeof(float);
+}
+
+/// APLs of the level with a beam mask (each also holds its coverage in memory: one float a texel).
+std::size_t masked_apls(const lumx::BundleLevelInfo& l) {
+  return std::size_t(std::count_if(l.mask.begin(), l.mask.end(), [](int i) { return i >= 0; }));
 }
 
 double level_flux(const lumx::BundleLevelInfo& l, lumx::ChannelLayout c) {
@@ -77,7 +84,8 @@ int run_bundle_info(const InfoArgs& a) {
                           {"bytes_on_disk", disk},
                           {"bytes_in_memory", level_memory_bytes(l, m.channels)},
                           {std::string("flux_") + flux_unit, level_flux(l, m.channels)},
-                          {"has_error_table", !l.error.empty()}});
+                          {"has_error_table", !l.error.empty()},
+                          {"masked_apls", masked_apls(l)}});
       }
       json j = {{"bundle", a.file},
                 {"format_version", m.format_version},
@@ -88,6 +96,7 @@ int run_bundle_info(const InfoArgs& a) {
                 {"provenance", m.provenance},
                 {"levels", levels},
                 {"total_bytes", m.total_bytes()}};
+      if (!m.masks.empty()) j["beam_masks"] = m.masks.size();
       if (m.volume)
         j["volume"] = {{"counts", {m.volume->counts.x, m.volume->counts.y, m.volume->counts.z}},
                        {"voxel_size_m", m.volume->voxel_size},
@@ -132,6 +141,13 @@ int run_bundle_info(const InfoArgs& a) {
       std::printf("  %-5zu %6zu %6d  %-24s %14.2f %13llu %13llu  %s\n", k, l.apl_count(), l.map_resolution,
                   stored.c_str(), level_flux(l, m.channels), (unsigned long long)disk,
                   (unsigned long long)level_memory_bytes(l, m.channels), l.error.empty() ? "no" : "yes");
+    }
+    if (!m.masks.empty()) {
+      std::size_t caps = 0;
+      for (const auto& mask : m.masks) caps += mask->caps().size();
+      std::printf("beam masks:  %zu (point sources behind apertures, %zu caps); masked APLs per level:", m.masks.size(), caps);
+      for (const auto& l : m.levels) std::printf(" %zu", masked_apls(l));
+      std::printf("\n");
     }
     if (m.volume)
       std::printf("volume:      %d x %d x %d voxels of %g m, %d SH bands, %d channel(s), %llu bytes\n",

@@ -148,11 +148,7 @@ TEST(CliBuild, PointSourcesBehindAperturesShipAsMaskedApls) {
   // The analytic suite's box with holes as a TM-25 file: lumx build finds the two point sources, says
   // so, and ships one masked APL per source in a format-3 bundle that lumx check accepts.
   const fs::path dir = lumx_test::fresh_temp_dir("lumx_cli_build_box");
-  using H = lumx_test::PinholeBox::Hole;
-  const lumx_test::PinholeBox box("box", 0.05,
-                                  {H{2, 1, -0.03, 0.01, -0.02, 0.03}, H{2, -1, 0.0, 0.03, -0.03, 0.0},
-                                   H{0, 1, -0.04, -0.01, -0.01, 0.03}, H{1, -1, -0.02, 0.02, -0.045, -0.02}},
-                                  {{{-0.02, 0.01, 0.0}, 500}, {{0.015, -0.01, 0.01}, 500}});
+  const lumx_test::PinholeBox box = lumx_test::suite_pinhole_box();
   auto src = box.source(lumx_test::kSanitized ? 200000 : 400000, 3);
   write_tm25((dir / "box.tm25ray").string(), src->info(), *src);
   const lumx_test::CliRun r =
@@ -167,5 +163,7 @@ TEST(CliBuild, PointSourcesBehindAperturesShipAsMaskedApls) {
   for (const Apl& a : set.levels[1].apls) EXPECT_TRUE(a.mask);
   const lumx_test::CliRun check = lumx_test::run_cli("check " + lumx_test::quoted(dir / "b"));
   EXPECT_EQ(check.status, 0) << check.out;
+  const lumx_test::CliRun info = lumx_test::run_cli("info " + lumx_test::quoted(dir / "b"));
+  EXPECT_TRUE(has(info.out, "beam masks:  2 (point sources behind apertures, 8 caps); masked APLs per level: 0 2")) << info.out;
   fs::remove_all(dir);
 }

@@ -26,14 +26,7 @@ using namespace lumx_test;
 
 namespace {
 
-// The suite's box with holes (test_apl_honest_error.cpp): two isotropic point sources in a 10 cm box.
-PinholeBox two_source_box() {
-  using H = PinholeBox::Hole;
-  return {"two point sources in a 10 cm box with four holes", 0.05,
-          {H{2, 1, -0.03, 0.01, -0.02, 0.03}, H{2, -1, 0.0, 0.03, -0.03, 0.0}, H{0, 1, -0.04, -0.01, -0.01, 0.03},
-           H{1, -1, -0.02, 0.02, -0.045, -0.02}},
-          {{{-0.02, 0.01, 0.0}, 500}, {{0.015, -0.01, 0.01}, 500}}};
-}
+PinholeBox two_source_box() { return suite_pinhole_box(); }
 const glm::dvec3 kSources[2] = {{-0.02, 0.01, 0.0}, {0.015, -0.01, 0.01}};
 
 double ray_flux(RaySource& rays) {

@@ -55,7 +55,8 @@ BUNDLE = words("format lumx-bundle format_version generator bounding_sphere cent
                "levels apl_count flux map_resolution maps bytes file pixel_type half float resolution sha256 "
                "parent position bounds min max error_vs_distance relative_distance relative_rmse provenance "
                "units intensity cd m radiance_unit irradiance volume sh_bands voxel_size counts window none "
-               "hann lanczos vallee_poussin attachments media_type length levels/ ../ missing negative")
+               "hann lanczos vallee_poussin attachments media_type length levels/ ../ missing negative "
+               "masks caps axis e1 e2 hull mask")
 EXR = ["channels", "chlist", "compression", "dataWindow", "displayWindow", "box2i", "lineOrder",
        "pixelAspectRatio", "screenWindowCenter", "screenWindowWidth", "v2f", "float", "tiles", "tiledesc",
        "type", "scanlineimage", "tiledimage", "chunkCount"]

@@ -1460,7 +1460,8 @@ inline AplSet centring_pilot(const AplSet& set, double sigma) {
   // A masked level (point sources behind apertures) already has its borders as geometry: its pilot is
   // its maps unsmoothed (a kernel would blur what the mask divides by its coverage), halved to R 8 at most
   // for their noise. On the box with holes this brought the masked level's estimate from 19-30 % to
-  // 7-24 % (its point error 2.7-3.2 %), the same at R 4 and R 16 (docs/apl_sets.md).
+  // 7-24 % (its point error 2.7-3.2 %; the same at R 4 and R 16), and 8 × 8 points a quarter in
+  // checked_centred_reference to 2.5-22.6 % (docs/apl_sets.md).
   if (pilot.levels[0].has_masks()) {
     int to = R;
     while (to > 8 && to % 2 == 0) to /= 2;
@@ -1576,7 +1577,11 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
     throw std::invalid_argument("checked_centred_reference: the fine reference is not on the quarters of the patches");
   const std::vector<std::vector<double>> centre = pilot_on_patches(pilot, ref, options, 1);
   // The quarters' means at 2 × 2 points each: the same 4 × 4 points per patch as centred_reference's P̄.
-  const std::vector<std::vector<double>> quarters = pilot_on_patches(pilot, fine, options, 2);
+  // A masked pilot's patches hold sharp borders, whose lit share 2 × 2 points find to a quarter: 8 × 8
+  // points a quarter there (on the box with holes the masked level's estimate went from
+  // 8.6/7.3/18.7/8.7/10.0/23.7 % to 2.5/4.7/17.7/4.2/5.6/22.6 % at d = 0.5 … 10; docs/apl_sets.md).
+  const std::vector<std::vector<double>> quarters =
+      pilot_on_patches(pilot, fine, options, pilot.levels.at(0).has_masks() ? 8 : 2);
   ReferenceIrradiance out = ref;
   const std::size_t W = std::size_t(2 * R), Wf = 2 * W;
   for (std::size_t s = 0; s < out.sphere.size(); ++s) {
