@@ -245,6 +245,54 @@ BENCHMARK(irradiance_512_apls_by_resolution)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(irradiance_coherent)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
 
+/// range(0) point sources behind four square apertures each (apl/point_sources.h), R 4 maps as the fit
+/// chose for the box with holes, read plain (range(1) = 0) or inside their beam masks (1): what a mask's
+/// containment test (caps × log vertices) and coverage lookup add per light.
+void irradiance_masked_apls(benchmark::State& state) {
+  const int sources = int(state.range(0));
+  const bool masked = state.range(1) != 0;
+  AplSet set;
+  set.bounds.radius = 0.1;
+  AplLevel level;
+  level.map_resolution = 4;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < sources; ++i) {
+    Apl a;
+    a.position = glm::vec3(0.05f * float(u(rng)), 0.05f * float(u(rng)), 0.05f * float(u(rng)));
+    std::vector<glm::dvec3> dirs;
+    const glm::dvec3 axes[4] = {{0, 0, -1}, {1, 0, -1}, {-1, 0, -1}, {0, 1, -1}};
+    for (const glm::dvec3& axis : axes)  // 20 000 directions through a 0.3 × 0.3 square about each axis
+      for (int j = 0; j < 20000; ++j) {
+        const glm::dvec3 z = glm::normalize(axis), x = glm::normalize(glm::cross(z, glm::dvec3(0, 1, 0.1)));
+        dirs.push_back(glm::normalize(z + 0.15 * u(rng) * x + 0.15 * u(rng) * glm::cross(z, x)));
+      }
+    a.mask = std::make_shared<const DirectionMask>(*DirectionMask::from_directions(dirs));
+    a.map = SphereMap(4, 1);
+    for (const glm::dvec3& w : dirs) {
+      int x, y;
+      a.map.texel_of(glm::vec3(w), x, y);
+      a.map.at(x, y, 0) += 1.0f;
+    }
+    refresh_coverage(a, level.frame);
+    if (!masked) a.mask.reset(), a.coverage = SphereMap();
+    level.apls.push_back(std::move(a));
+  }
+  set.levels.push_back(std::move(level));
+  update_fluxes(set);
+  std::vector<glm::vec3> points(4096);
+  for (glm::vec3& p : points) p = glm::vec3(float(u(rng)), float(u(rng)), -1.0f + 0.5f * float(u(rng)));
+  const glm::vec3 n(0, 0, 1);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(irradiance(set, 0, points[i], n).irradiance);
+    i = (i + 1) & 4095;
+  }
+  state.counters["ns_per_light"] = benchmark::Counter(double(state.iterations()) * sources,
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(irradiance_masked_apls)->Args({2, 0})->Args({2, 1})->Args({64, 0})->Args({64, 1})->Unit(benchmark::kMicrosecond);
+
 void sample(benchmark::State& state) {
   std::mt19937 rng(4);
   const SphereMap map = lobe_map(rng);
