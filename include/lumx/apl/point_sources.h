@@ -10,9 +10,10 @@
 // puts APLs between the sources, whose rays mix both (step 1b: the lines' points nearest a convergence
 // point between the sources). When every ray's line passes through one of a few points, the light is
 // that of point sources, so:
-//   1. the sources are the positions of the built set's finest level (step 6 placed most of its APLs on
-//      them) through which at least `min_rays` lines pass within `tolerance` of the bounding radius,
-//      on the side the rays leave from (the source is behind, or at, each ray's start);
+//   1. the candidates are the least-squares points of the finest clusters' lines and the finest level's
+//      positions (step 6 placed most of its APLs on the sources); a source is a candidate through which
+//      at least `min_rays` lines pass within `tolerance` of the bounding radius, on the side the rays
+//      leave from (the source is behind, or at, each ray's start), the candidates with most lines first;
 //   2. every ray goes to the source its line passes nearest; when one passes none, there are no point
 //      sources and the built set stands;
 //   3. each source moves to its own rays' least-squares point (LineFit), and its directions become its
@@ -101,7 +102,7 @@ void for_each_ray_chunk(RaySource& rays, std::size_t chunk_rays, unsigned thread
 }  // namespace detail
 
 /// The point-source set of `rays` (module comment), or nothing, with the reason in report.why.
-/// `candidates`: the built set's finest positions; `bounds`: its bounding sphere; `level_counts`: the
+/// `candidates`: points that may be sources (the builder's: its finest clusters' points); `bounds`: its bounding sphere; `level_counts`: the
 /// requested APLs per level (increasing); `resolution(apls)`: the map resolution of a level of that many
 /// APLs; `frame`: the maps' frame. Rays are read `chunk_rays` at a time (each chunk at most that many).
 /// Deterministic: rays are classified independently on `threads` threads and summed in file order.
@@ -124,6 +125,7 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
   // The candidates, each within 2·eps of an earlier one dropped (many APLs sit on one source).
   std::vector<glm::dvec3> points;
   for (const glm::vec3& c : candidates) {
+    if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) continue;
     bool seen = false;
     for (const glm::dvec3& q : points) seen = seen || glm::length(q - glm::dvec3(c)) <= 2 * eps;
     if (!seen) points.emplace_back(c);
