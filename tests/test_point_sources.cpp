@@ -147,7 +147,7 @@ TEST(PointSources, TheSameSetForAnyThreadCount) {
 }
 
 TEST(PointSources, MaskedEmissionSamplesAreUnbiased) {
-  // E[sample flux] = ∫ I(ω) dω, the masked intensity's integral, computed here by quadrature over 64 × 64
+  // E[sample flux] = ∫ I(ω) dω, the masked intensity's integral, computed here by quadrature over 16 × 16
   // sub-directions per texel of R 32 (no sampling). Each sample's flux is I(ω)/pdf: 0 outside the mask.
   const PinholeBox box = two_source_box();
   auto rays = box.source(400000, 9);
@@ -254,7 +254,9 @@ TEST(PointSources, MasksRoundTripThroughTheBundle) {
   refused([](J& j) { j["masks"][0]["caps"][0]["hull"][0] = J::array({1.0, 2.0, 3.0}); }, "/masks/0/caps/0/hull/0",
           "expected 2");
   refused([](J& j) { j["masks"][0]["caps"] = J::array(); }, "/masks/0/caps", "0 caps");
-  refused([](J& j) { j["masks"][0]["caps"][0]["axis"] = J::array({2.0, 0.0, 0.0}); }, "/masks/0", "orthonormal");
+  refused([](J& j) { j["masks"][0]["caps"][0]["axis"] = J::array({2.0, 0.0, 0.0}); }, "/masks/0/caps/0", "orthonormal");
+  // A level whose masks' coverage would take more than BundleLimits::max_mask_tests (R 4096).
+  refused([](J& j) { j["levels"][1]["map_resolution"] = 4096; }, "/levels/1/mask", "max_mask_tests");
   refused([](J& j) { j["masks"][0]["caps"][0]["extra"] = 1; }, "/masks/0/caps/0", "extra");
   refused([](J& j) { j["masks"][0]["caps"][0]["hull"][1][0] = nullptr; }, "/masks/0/caps/0/hull/1/0", "number");
   refused(
@@ -262,7 +264,69 @@ TEST(PointSources, MasksRoundTripThroughTheBundle) {
         J& h = j["masks"][0]["caps"][0]["hull"];
         std::reverse(h.begin(), h.end());  // clockwise
       },
-      "/masks/0", "counter-clockwise");
+      "/masks/0/caps/0", "counter-clockwise");
+}
+
+TEST(PointSources, AFittedLevelsCoverageIsWhatItsBundleReadsBack) {
+  // downsampled_level (the fit) computes the coverage afresh at the new resolution, as a reader loading
+  // the level there does: the graded level and the shipped one agree bit for bit.
+  const PinholeBox box = two_source_box();
+  auto rays = box.source(200000, 13);
+  AplBuildOptions bo;
+  bo.map_resolution = 32;
+  AplSet set = build_apl_set(*rays, bo);
+  ASSERT_TRUE(set.levels.back().has_masks());
+  const auto dir = fresh_temp_dir("point_sources_fitted");
+  write_bundle((dir / "b.lumx").string(), set);
+  const AplLevel fitted = downsampled_level(set.levels[1], 8);
+  const AplLevel loaded = BundleReader((dir / "b.lumx").string()).load_level(1, 8);
+  for (std::size_t i = 0; i < fitted.size(); ++i) {
+    ASSERT_EQ(loaded.apls[i].coverage.resolution(), 8);
+    EXPECT_EQ(loaded.apls[i].coverage.values(), fitted.apls[i].coverage.values()) << i;
+  }
+  EXPECT_TRUE(check_apl_set(set).empty());
+}
+
+TEST(PointSources, ContainmentByBisectionIsTheTestOfEveryEdge) {
+  // DirectionMask::contains bisects each cap's hull; against the plain test of every edge (the point
+  // left of or on each), on random points, points on edges and points next to vertex 0 of a hull.
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<glm::dvec3> dirs;
+  for (int j = 0; j < 5000; ++j) dirs.push_back(glm::normalize(glm::dvec3(0.3 * u(rng), 0.2 * u(rng), 1.0)));
+  const DirectionMask mask = *DirectionMask::from_directions(dirs);
+  ASSERT_EQ(mask.caps().size(), 1u);
+  const DirectionMask::Cap& c = mask.caps()[0];
+  const auto every_edge = [&](const glm::dvec2& q) {
+    const std::size_t n = c.hull.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const glm::dvec2 &a = c.hull[i], &b = c.hull[(i + 1) % n];
+      if ((b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x) < 0) return false;
+    }
+    return true;
+  };
+  const auto direction = [&](const glm::dvec2& q) { return glm::normalize(c.axis + q.x * c.e1 + q.y * c.e2); };
+  const auto chart = [&](const glm::dvec3& w) {
+    const double z = glm::dot(w, c.axis);
+    return glm::dvec2(glm::dot(w, c.e1) / z, glm::dot(w, c.e2) / z);
+  };
+  int disagree = 0, inside = 0, tried = 0;
+  const auto check = [&](const glm::dvec2& q) {
+    const glm::dvec3 w = direction(q);
+    const bool want = every_edge(chart(w));  // the same chart coordinates contains() computes
+    disagree += mask.contains(w) != want;
+    inside += want;
+    ++tried;
+  };
+  for (int j = 0; j < 20000; ++j) check({0.4 * u(rng), 0.3 * u(rng)});
+  for (std::size_t i = 0; i < c.hull.size(); ++i)
+    for (int j = 0; j < 50; ++j) {
+      const double t = 0.5 * (u(rng) + 1);
+      check(c.hull[i] + t * (c.hull[(i + 1) % c.hull.size()] - c.hull[i]));
+    }
+  for (int j = 0; j < 2000; ++j) check(c.hull[0] + 1e-9 * glm::dvec2(u(rng), u(rng)));
+  EXPECT_EQ(disagree, 0) << "of " << tried << " points, " << inside << " inside";
+  EXPECT_GT(inside, 1000);
 }
 
 TEST(PointSources, FromCapsRefusesWhatIsNoConvexHull) {
@@ -273,6 +337,15 @@ TEST(PointSources, FromCapsRefusesWhatIsNoConvexHull) {
   twice.hull = {{1, 0}, {-0.809, 0.588}, {0.309, -0.951}, {0.309, 0.951}, {-0.809, -0.588}};
   for (auto& p : twice.hull) p *= 0.1;
   EXPECT_THROW(DirectionMask::from_caps({twice}), std::invalid_argument);
+  // A limaçon r = 1 + 2 cos t: every turn left and once around its vertices' mean, yet its edges turn
+  // twice (an inner loop), so it is no convex hull.
+  DirectionMask::Cap limacon = c;
+  limacon.hull.clear();
+  for (int i = 0; i < 139; ++i) {
+    const double t = 2 * kPi * i / 139.0, r = 1 + 2 * std::cos(t);
+    limacon.hull.push_back(0.25 * glm::dvec2(r * std::cos(t), r * std::sin(t)) - glm::dvec2(0.3, 0));
+  }
+  EXPECT_THROW(DirectionMask::from_caps({limacon}), std::invalid_argument);
   DirectionMask::Cap skew = c;
   skew.e1 = glm::dvec3(1, 0.01, 0);
   EXPECT_THROW(DirectionMask::from_caps({skew}), std::invalid_argument);

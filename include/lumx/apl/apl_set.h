@@ -143,19 +143,43 @@ struct AplLevel {
   }
 };
 
-/// Recomputes a masked APL's coverage at its map's resolution in `frame` (no-op without a mask): wherever
-/// a map changes resolution (a fit, a partial load) its coverage must follow.
+/// Recomputes a masked APL's coverage at its map's resolution in `frame` (clears it without a mask):
+/// wherever a map changes resolution (a fit, a partial load) its coverage must follow.
 inline void refresh_coverage(Apl& a, const MapFrame& frame) {
   if (!a.mask) {
     a.coverage = SphereMap();
     return;
   }
-  if (a.coverage.resolution() == a.map.resolution() && !a.coverage.empty()) return;
   a.coverage = a.mask->coverage(a.map.resolution(), glm::transpose(frame.to_map), kMaskCoverageSubsamples);
 }
+/// refresh_coverage for every APL of the level, each distinct mask's coverage computed once and shared
+/// (the APLs of one source share its mask).
 inline void refresh_coverages(AplLevel& level) {
-  for (Apl& a : level.apls) refresh_coverage(a, level.frame);
+  std::vector<const Apl*> done;
+  for (Apl& a : level.apls) {
+    if (!a.mask) {
+      a.coverage = SphereMap();
+      continue;
+    }
+    const Apl* same = nullptr;
+    for (const Apl* d : done)
+      if (d->mask == a.mask && d->map.resolution() == a.map.resolution()) same = d;
+    if (same) {
+      a.coverage = same->coverage;
+    } else {
+      a.coverage = SphereMap();
+      refresh_coverage(a, level.frame);
+      done.push_back(&a);
+    }
+  }
 }
+
+/// Limits every bundle reader applies by default (io/bundle_io.h BundleLimits), which the builder keeps
+/// to so that what it writes can be read: caps per mask, vertices per cap, and the containment tests
+/// the coverage of a whole set's masks takes at the levels' resolutions.
+inline constexpr std::size_t kMaxMaskCaps = 256;
+inline constexpr std::size_t kMaxMaskHullVertices = 4096;
+inline constexpr double kMaxMaskTests = 2147483648.0;  // 2^31: a few seconds
 
 /// A luminaire's APL set: levels ordered by increasing APL count, plus what a reader needs to use it.
 struct AplSet {

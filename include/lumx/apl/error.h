@@ -488,6 +488,7 @@ struct LevelErrors {
   double ns_per_evaluation = NAN;  ///< mean time of one irradiance evaluation on one thread (ns; NaN: untimed)
   std::size_t bytes = 0;           ///< AplLevel::map_bytes() (for the far field: level 0's)
   std::size_t clamped = 0;         ///< APL distances clamped to the minimum (IrradianceResult::clamped)
+  bool masked = false;             ///< the level has masked APLs (point sources behind apertures)
 };
 
 namespace detail {
@@ -596,6 +597,7 @@ inline LevelErrors evaluate_level(const AplSet& set, std::size_t k, const Refere
   row.apls = level.size();
   row.map_resolution = level.map_resolution;
   row.bytes = level.map_bytes();
+  row.masked = level.has_masks();
   detail::evaluate_rows(ref, options, row,
                         [&](std::size_t, const glm::vec3& x, const glm::vec3& n, std::size_t* clamped) {
                           return detail::level_luminance_at(set, k, x, n, options.irradiance, clamped);
@@ -974,14 +976,14 @@ inline AplLevel downsampled_level(const AplLevel& level, int R) {
   if (R == level.map_resolution) return out;
   for (Apl& a : out.apls) {
     while (a.map.resolution() > R) a.map = a.map.downsampled();
-    // A texel's lit fraction at R/2 is the mean of its four children's (equal areas; their sub-directions
-    // nest), so a mask's coverage is downsampled with its map, exactly.
-    while (a.mask && a.coverage.resolution() > R) a.coverage = a.coverage.downsampled();
     if (a.map.resolution() != R)
       throw std::invalid_argument("downsampled_level: " + std::to_string(R) + " is not a power-of-two fraction of " +
                                   std::to_string(level.map_resolution));
   }
   out.map_resolution = R;
+  // A mask's coverage computed afresh at R, as a reader loading the level at R computes it (averaging the
+  // children's would sample each texel finer than that, and the bundle would read back other values).
+  if (out.has_masks()) refresh_coverages(out);
   return out;
 }
 
@@ -1065,7 +1067,9 @@ inline AplLevel smoothed_level(const AplLevel& level, const SphereMapKernel& ker
 inline AplLevel fitted_level(const AplLevel& level, int R, double kappa, KernelMode mode = KernelMode::plain,
                              HarmonicEstimateCache* cache = nullptr) {
   AplLevel out = downsampled_level(level, R);
-  if (kappa > 0) out = smoothed_level(out, *SphereMapKernel::shared(R, kappa), 0, mode, cache);
+  // A masked level is never smoothed (fit_map_resolutions grades it plain): a kernel chosen for another
+  // kind of level (a half set with other sources) is not applied to it.
+  if (kappa > 0 && !out.has_masks()) out = smoothed_level(out, *SphereMapKernel::shared(R, kappa), 0, mode, cache);
   return out;
 }
 
@@ -1727,7 +1731,10 @@ inline void store_error_tables(AplSet& set, const AplErrorReport& report) {
 /// tiny rayset can give other levels).
 inline bool apply_held_out_fit(AplSet& set, const AplErrorReport& report, const ResolutionChoice* choice = nullptr) {
   bool same = report.levels.size() == set.levels.size();
-  for (std::size_t k = 0; same && k < set.levels.size(); ++k) same = report.levels[k].apls == set.levels[k].size();
+  // The same APL counts, and masked where the graded levels were (a half set may find point sources
+  // where the whole set, with a stray ray, does not).
+  for (std::size_t k = 0; same && k < set.levels.size(); ++k)
+    same = report.levels[k].apls == set.levels[k].size() && report.levels[k].masked == set.levels[k].has_masks();
   if (!same) return false;
   HarmonicEstimateCache spectra;
   if (choice)

@@ -30,8 +30,11 @@
 // empty and equalled the two-APL rows to 0.01 points).
 //
 // Cost: one pass over the rays to count the lines through each candidate, which ends at the first ray
-// that passes none (for any extended emitter, almost always the first: 4 096 rays are read), a second to
-// assign the rays, a third to bin them. Memory: the directions of every ray (24 bytes each) while the masks are made.
+// that passes none (for any extended emitter, almost always the first: 4 096 rays are read); one to
+// assign the rays to the sources, again for each round that drops a source; one to gather each source's
+// rays; one to bin them. Memory: each ray's source (4 bytes) and direction (24 bytes, while the masks are
+// made). A set whose masks a bundle reader would refuse by default (apl_set.h: kMaxMaskCaps,
+// kMaxMaskHullVertices, kMaxMaskTests) is not made.
 #pragma once
 
 #include <lumx/apl/apl_set.h>
@@ -80,9 +83,10 @@ inline bool line_passes(const glm::dvec3& c, const glm::dvec3& o, const glm::dve
   return along <= tolerance && distance <= tolerance;
 }
 
-/// Reads every ray of `rays` in chunks, calling prepare(n) for a chunk of n rays, per(i, index, chunk) on
-/// up to `threads` threads for each of its rays (i: in the chunk, index: in the file), then
-/// after(chunk, first_index) on this thread, which returns whether to go on.
+/// Reads every ray of `rays` in chunks, calling prepare(n) for a chunk of n rays, per(job, i, chunk) on
+/// up to `threads` threads for each of its rays (job: one of kRayJobs, each a range of the chunk; i: in
+/// the chunk), then after(chunk, first_index) on this thread, which returns whether to go on.
+inline constexpr std::size_t kRayJobs = 16;
 template <class Prepare, class PerRay, class After>
 void for_each_ray_chunk(RaySource& rays, std::size_t chunk_rays, unsigned threads, Prepare&& prepare, PerRay&& per,
                         After&& after) {
@@ -90,10 +94,10 @@ void for_each_ray_chunk(RaySource& rays, std::size_t chunk_rays, unsigned thread
   std::uint64_t first = 0;
   rays.rewind();
   while (rays.next(chunk, chunk_rays)) {
-    const std::size_t n = chunk.size(), jobs = std::min<std::size_t>(n, 16);
+    const std::size_t n = chunk.size(), jobs = std::min<std::size_t>(n, kRayJobs);
     prepare(n);
     parallel_jobs(jobs, threads, [&](std::size_t j) {
-      for (std::size_t i = n * j / jobs; i < n * (j + 1) / jobs; ++i) per(i, first + i, chunk);
+      for (std::size_t i = n * j / jobs; i < n * (j + 1) / jobs; ++i) per(j, i, chunk);
     });
     if (!after(chunk, first)) return;
     first += n;
@@ -134,35 +138,39 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
   if (P == 0) return none("no candidate point");
 
   // ---- 1. the lines through each candidate; stops at the first ray (with flux) through none
-  std::vector<std::uint64_t> through(P, 0);
-  std::vector<std::uint8_t> hits, passes_none;
+  // Counts per job (integers: their sum does not depend on the order), so memory is kRayJobs × P counts
+  // whatever the chunk; the first ray through none stops the pass.
+  std::vector<std::uint64_t> through(P, 0), job_through(detail::kRayJobs * P, 0);
+  std::vector<std::uint8_t> passes_none;
   std::uint64_t missing = UINT64_MAX;
   // Small chunks: an extended emitter's first ray through no candidate ends the pass after 4 096 rays.
   detail::for_each_ray_chunk(
       rays, std::min<std::size_t>(chunk_rays, 4096), threads,
       [&](std::size_t n) {
-        if (passes_none.size() < n) hits.resize(n * P), passes_none.resize(n);
+        if (passes_none.size() < n) passes_none.resize(n);
       },
-      [&](std::size_t i, std::uint64_t, const RayChunk& c) {
+      [&](std::size_t job, std::size_t i, const RayChunk& c) {
+        passes_none[i] = 0;
+        if (!(c.flux[i] > 0)) return;  // a ray without flux needs no source
         const glm::dvec3 o(c.position(i)), w(c.direction(i));
-        bool any = !(c.flux[i] > 0);  // a ray without flux needs no source
+        bool any = false;
+        std::uint64_t* counts = job_through.data() + job * P;
         for (std::size_t p = 0; p < P; ++p) {
           double d;
-          hits[i * P + p] = c.flux[i] > 0 && detail::line_passes(points[p], o, w, eps, d);
-          any = any || hits[i * P + p];
+          if (detail::line_passes(points[p], o, w, eps, d)) ++counts[p], any = true;
         }
         passes_none[i] = !any;
       },
       [&](const RayChunk& c, std::uint64_t first) {
-        for (std::size_t i = 0; i < c.size(); ++i) {
+        for (std::size_t i = 0; i < c.size(); ++i)
           if (passes_none[i]) {
             missing = first + i;
             return false;
           }
-          for (std::size_t p = 0; p < P; ++p) through[p] += hits[i * P + p];
-        }
         return true;
       });
+  for (std::size_t j = 0; j < detail::kRayJobs; ++j)
+    for (std::size_t p = 0; p < P; ++p) through[p] += job_through[j * P + p];
   if (missing != UINT64_MAX)
     return none("ray " + std::to_string(missing) + "'s line passes none of the " + std::to_string(P) +
                 " candidate points");
@@ -208,7 +216,7 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
         [&](std::size_t n) {
           if (chunk_source.size() < n) chunk_source.resize(n);
         },
-        [&](std::size_t i, std::uint64_t, const RayChunk& c) {
+        [&](std::size_t, std::size_t i, const RayChunk& c) {
           chunk_source[i] = kNoSource;
           if (!(c.flux[i] > 0)) return;
           const glm::dvec3 o(c.position(i)), w(c.direction(i));
@@ -330,6 +338,22 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
     set.levels.push_back(std::move(level));
   }
   std::vector<std::vector<glm::dvec3>>().swap(directions);
+  // What a bundle reader accepts by default (apl_set.h), so that the set can be written and read back.
+  double tests = 0;
+  for (const AplLevel& level : set.levels)
+    for (std::size_t a = 0; a < level.apls.size(); ++a) {
+      const std::shared_ptr<const DirectionMask>& m = level.apls[a].mask;
+      if (!m) continue;
+      if (m->caps().size() > kMaxMaskCaps) return none("a source's mask has " + std::to_string(m->caps().size()) + " caps");
+      for (const DirectionMask::Cap& c : m->caps())
+        if (c.hull.size() > kMaxMaskHullVertices)
+          return none("a source's mask has a hull of " + std::to_string(c.hull.size()) + " vertices");
+      tests += m->coverage_tests(level.map_resolution, kMaskCoverageSubsamples) +
+               2.0 * level.map_resolution * level.map_resolution;
+    }
+  if (tests > kMaxMaskTests)
+    return none("the masks' coverage would take " + std::to_string(tests) + " tests (at most " +
+                std::to_string(kMaxMaskTests) + ")");
 
   // ---- 5. maps: each ray's flux, as intensity, in its source's APL of every level (file order)
   std::vector<std::vector<double>> sums(set.levels.size());

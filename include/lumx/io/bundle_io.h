@@ -132,12 +132,12 @@ struct BundleLimits {
   std::size_t max_levels = 64;
   std::size_t max_apls_per_level = 1u << 20;
   std::size_t max_masks = 4096;             ///< beam masks in a manifest
-  std::size_t max_caps_per_mask = 256;      ///< caps in one mask
-  std::size_t max_hull_vertices = 1u << 12; ///< vertices of one cap's hull
+  std::size_t max_caps_per_mask = kMaxMaskCaps;            ///< caps in one mask (256)
+  std::size_t max_hull_vertices = kMaxMaskHullVertices;    ///< vertices of one cap's hull (4 096)
   /// The reader computes each masked APL's coverage (8 × 8 sub-directions a texel, each tested against
-  /// every cap in O(log vertices)); a level whose masks would take more tests than this at its full
-  /// resolution is refused (2^31: a few seconds), so a hostile manifest cannot make loading hang.
-  std::uint64_t max_mask_tests = 1ull << 31;
+  /// every cap in O(log vertices)); a manifest whose masks would take more tests than this over its
+  /// levels at their full resolutions is refused (2^31: a few seconds), so a hostile manifest cannot make loading hang.
+  std::uint64_t max_mask_tests = std::uint64_t(kMaxMaskTests);
   /// Largest decoded size of one payload in memory (float texels or coefficients). A compressed payload
   /// of a few megabytes can decode to gigabytes, so this bounds memory, not file size.
   std::uint64_t max_decoded_bytes = 2ull << 30;

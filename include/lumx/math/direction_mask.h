@@ -108,15 +108,16 @@ class DirectionMask {
           throw std::invalid_argument(at + "vertices " + std::to_string(v) + " to " + std::to_string((v + 2) % n) +
                                       " do not turn counter-clockwise: not a convex hull");
       }
-      // Every turn left and once around (the angles about the vertices' mean add up to 2π): convex.
-      glm::dvec2 mean(0.0);
-      for (const glm::dvec2& p : c.hull) mean += p / double(c.hull.size());
+      // Every turn left and the edges' directions once around (their turning angles add up to 2π, not
+      // 2πk): a convex polygon. (Winding once about one point is not enough: a curve with a loop can.)
       double turn = 0;
-      for (std::size_t v = 0; v < c.hull.size(); ++v) {
-        const glm::dvec2 a = c.hull[v] - mean, b = c.hull[(v + 1) % c.hull.size()] - mean;
+      const std::size_t n = c.hull.size();
+      for (std::size_t v = 0; v < n; ++v) {
+        const glm::dvec2 a = c.hull[(v + 1) % n] - c.hull[v], b = c.hull[(v + 2) % n] - c.hull[(v + 1) % n];
         turn += std::atan2(a.x * b.y - a.y * b.x, glm::dot(a, b));
       }
-      if (!(std::abs(turn - 2 * kPi) < 1e-6)) throw std::invalid_argument(at + "the hull winds more than once: not convex");
+      if (!(std::abs(turn - 2 * kPi) < 1e-6))
+        throw std::invalid_argument(at + "its edges turn " + std::to_string(turn / (2 * kPi)) + " times around: not convex");
       if (c.min_cos < min_cos) throw std::invalid_argument(at + "reaches beyond " + std::to_string(options.max_half_angle) + " rad of its axis");
       c.reach = std::acos(std::clamp(c.min_cos, -1.0, 1.0));
     }
@@ -126,6 +127,16 @@ class DirectionMask {
   }
 
   const std::vector<Cap>& caps() const { return caps_; }
+
+  /// The containment tests coverage(R, …, sub) may make at most: every sub-direction of every texel
+  /// against every cap, each in 1 + log2(vertices) steps. What a reader bounds before it computes one.
+  double coverage_tests(int resolution, int sub) const {
+    double tests = 0;
+    for (const Cap& c : caps_)
+      tests += 2.0 * double(resolution) * double(resolution) * double(sub) * double(sub) *
+               (1.0 + std::log2(double(std::max<std::size_t>(1, c.hull.size()))));
+    return tests;
+  }
 
   /// Whether unit direction w lies in some cap (on a border counts as inside).
   bool contains(const glm::dvec3& w) const {
@@ -193,7 +204,8 @@ class DirectionMask {
   /// fan wedge from h[0] that holds q by bisection, then that wedge's outer edge.
   static bool inside_hull(const std::vector<glm::dvec2>& h, const glm::dvec2& q) {
     const std::size_t n = h.size();
-    if (n < 3 || cross2(h[0], h[1], q) < 0 || cross2(h[0], h[n - 1], q) > 0) return false;
+    // The two edges at h[0] with the same arithmetic as a test of every edge (h[i] → h[i+1]).
+    if (n < 3 || cross2(h[0], h[1], q) < 0 || cross2(h[n - 1], h[0], q) < 0) return false;
     std::size_t lo = 1, hi = n - 1;  // cross2(h0, h[lo], q) ≥ 0 > cross2(h0, h[hi], q), or hi = n − 1
     while (hi - lo > 1) {
       const std::size_t mid = (lo + hi) / 2;

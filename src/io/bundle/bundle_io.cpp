@@ -19,6 +19,7 @@
 #include <stdio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
@@ -472,8 +473,10 @@ AplSet BundleReader::load(const std::vector<std::size_t>& levels, int max_resolu
   for (std::size_t k : chosen) {
     if (k >= manifest_.levels.size()) break;  // load_level reports it
     const BundleLevelInfo& l = manifest_.levels[k];
-    decoded += std::uint64_t(l.apl_count()) * 2 * std::uint64_t(l.map_resolution) * std::uint64_t(l.map_resolution) *
-               std::uint64_t(channel_count(manifest_.channels)) * sizeof(float);
+    const std::uint64_t masked = std::uint64_t(std::count_if(l.mask.begin(), l.mask.end(), [](int i) { return i >= 0; }));
+    // Each map's texels, and a masked APL's coverage (one channel) beside its map.
+    decoded += (std::uint64_t(l.apl_count()) * std::uint64_t(channel_count(manifest_.channels)) + masked) * 2 *
+               std::uint64_t(l.map_resolution) * std::uint64_t(l.map_resolution) * sizeof(float);
   }
   if (max_resolution <= 0 && decoded > limits_.max_loaded_bytes)
     fail(path_, "levels", "loading them would take " + std::to_string(decoded) + " bytes, above BundleLimits::max_loaded_bytes (" +

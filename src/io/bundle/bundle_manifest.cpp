@@ -331,11 +331,14 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
           out[c].hull.push_back({r.number(xy[0], vp + "/0"), r.number(xy[1], vp + "/1")});
         }
       }
-      try {
-        m.masks.push_back(std::make_shared<const DirectionMask>(DirectionMask::from_caps(std::move(out))));
-      } catch (const std::invalid_argument& e) {
-        r.fail(at, e.what());
+      for (std::size_t c = 0; c < out.size(); ++c) {  // each cap alone first, for its pointer
+        try {
+          (void)DirectionMask::from_caps({out[c]});
+        } catch (const std::invalid_argument& e) {
+          r.fail(at + "/caps/" + std::to_string(c), std::string(e.what()).substr(std::string("cap 0: ").size()));
+        }
       }
+      m.masks.push_back(std::make_shared<const DirectionMask>(DirectionMask::from_caps(std::move(out))));
     }
   }
 
@@ -344,6 +347,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
   if (levels.size() > limits.max_levels) r.fail("/levels", std::to_string(levels.size()) + " levels exceed BundleLimits::max_levels (" +
                                                                     std::to_string(limits.max_levels) + ")");
   std::set<std::string> files;
+  double mask_tests = 0;  // the masks' coverage work, over every level (BundleLimits::max_mask_tests)
   for (std::size_t k = 0; k < levels.size(); ++k) {
     const std::string at = "/levels/" + std::to_string(k);
     const json& lj = levels[k];
@@ -397,19 +401,18 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
       const json& list = r.array(*mk, at + "/mask", n);
       for (std::size_t i = 0; i < n; ++i)
         l.mask.push_back(int(r.integer(list[i], at + "/mask/" + std::to_string(i), -1, (long long)m.masks.size() - 1)));
-      // The coverage's cost at full resolution, each distinct mask once (APLs share a source's).
+      // The coverage's cost at full resolution, summed over the manifest: each distinct mask once per
+      // level (refresh_coverages shares it between the APLs of one source), and a copy of its coverage
+      // per masked APL.
       std::set<int> distinct(l.mask.begin(), l.mask.end());
-      double tests = 0;
-      for (int q : distinct) {
-        if (q < 0) continue;
-        for (const DirectionMask::Cap& c : m.masks[std::size_t(q)]->caps())
-          tests += 2.0 * l.map_resolution * l.map_resolution * double(kMaskCoverageSubsamples * kMaskCoverageSubsamples) *
-                   (1.0 + std::log2(double(c.hull.size())));
-      }
-      if (tests > double(limits.max_mask_tests))
-        r.fail(at + "/mask", "its masks' coverage at R " + std::to_string(l.map_resolution) + " would take " +
-                                 std::to_string(tests) + " tests, above BundleLimits::max_mask_tests (" +
-                                 std::to_string(limits.max_mask_tests) + ")");
+      for (int q : distinct)
+        if (q >= 0) mask_tests += m.masks[std::size_t(q)]->coverage_tests(l.map_resolution, kMaskCoverageSubsamples);
+      for (int q : l.mask)
+        if (q >= 0) mask_tests += 2.0 * l.map_resolution * l.map_resolution;
+      if (mask_tests > double(limits.max_mask_tests))
+        r.fail(at + "/mask", "the masks' coverage up to this level at R " + std::to_string(l.map_resolution) +
+                                 " would take " + std::to_string(mask_tests) +
+                                 " tests, above BundleLimits::max_mask_tests (" + std::to_string(limits.max_mask_tests) + ")");
     }
     const json& maps = r.array(r.member(lj, at, "maps"), at + "/maps", std::size_t(-1));
     if (maps.empty() || maps.size() > 16) r.fail(at + "/maps", "must list 1 to 16 payloads");
