@@ -51,8 +51,12 @@ struct Apl {
 /// Coverage below this is raised to it in a masked lookup (DirectionMask::normalised_lookup): a sliver of
 /// a texel that the bilinear weights barely reach would otherwise divide noise by almost nothing.
 inline constexpr float kMinMaskCoverage = 1.0f / 16;
-/// Sub-directions per texel side of a mask's coverage: 8 × 8, a border texel's lit fraction to ±1/16.
-inline constexpr int kMaskCoverageSubsamples = 8;
+/// Sub-directions per texel side of a mask's coverage at map resolution R: 1024 / R (8 at R 128, 256 at
+/// R 4), at least 8, so that a border is sampled on the same 2048 × 1024 grid of the sphere at every R up
+/// to 128. That grid nests: the coverage at R/2 is the mean of its four children's at R, so a level the fit
+/// coarsens reads its border as finely as the built one (8 × 8 sub-directions at R 4 find a border
+/// texel's lit fraction only to ±1/16 of a texel 0.3 rad wide).
+inline int mask_coverage_subsamples(int resolution) { return std::clamp(1024 / std::max(1, resolution), 8, 256); }
 
 /// Relative RMSE of a level's irradiance against a reference, on spheres of relative distance d
 /// (000 §5.3, eq. 5.1). Filled by the builder; read by the error-target level choice.
@@ -150,7 +154,7 @@ inline void refresh_coverage(Apl& a, const MapFrame& frame) {
     a.coverage = SphereMap();
     return;
   }
-  a.coverage = a.mask->coverage(a.map.resolution(), glm::transpose(frame.to_map), kMaskCoverageSubsamples);
+  a.coverage = a.mask->coverage(a.map.resolution(), glm::transpose(frame.to_map), mask_coverage_subsamples(a.map.resolution()));
 }
 /// refresh_coverage for every APL of the level, each distinct mask's coverage computed once and shared
 /// (the APLs of one source share its mask).

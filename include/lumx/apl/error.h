@@ -1463,9 +1463,8 @@ inline AplSet centring_pilot(const AplSet& set, double sigma) {
   int R = pilot.levels[0].map_resolution;
   // A masked level (point sources behind apertures) already has its borders as geometry: its pilot is
   // its maps unsmoothed (a kernel would blur what the mask divides by its coverage), halved to R 8 at most
-  // for their noise. On the box with holes this brought the masked level's estimate from 19-30 % to
-  // 7-24 % (its point error 2.7-3.2 %; the same at R 4 and R 16), and 8 × 8 points a quarter in
-  // checked_centred_reference to 2.5-22.6 % (docs/apl_sets.md).
+  // for their noise. The box's masked level is then estimated at 2.5-22.6 % where it is 2.7-3.2 % off
+  // (PinholeBoxStudy.DISABLED_HeldOutEstimateOfTheMaskedLevel; with a sharpened texel pilot it was 19-30 %).
   if (pilot.levels[0].has_masks()) {
     int to = R;
     while (to > 8 && to % 2 == 0) to /= 2;
@@ -1582,8 +1581,7 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
   const std::vector<std::vector<double>> centre = pilot_on_patches(pilot, ref, options, 1);
   // The quarters' means at 2 × 2 points each: the same 4 × 4 points per patch as centred_reference's P̄.
   // A masked pilot's patches hold sharp borders, whose lit share 2 × 2 points find to a quarter: 8 × 8
-  // points a quarter there (on the box with holes the masked level's estimate went from
-  // 8.6/7.3/18.7/8.7/10.0/23.7 % to 2.5/4.7/17.7/4.2/5.6/22.6 % at d = 0.5 … 10; docs/apl_sets.md).
+  // points a quarter there (docs/apl_sets.md, "What the table stores").
   const std::vector<std::vector<double>> quarters =
       pilot_on_patches(pilot, fine, options, pilot.levels.at(0).has_masks() ? 8 : 2);
   ReferenceIrradiance out = ref;

@@ -22,18 +22,20 @@
 //   4. the levels are cuts of a cluster tree over the sources (eq. 4.1), as many APLs as requested but
 //      at most one per source: a box with two sources gets levels of 1 and 2 APLs. An APL of one source
 //      sits at it with its mask; an APL of several at their rays' least-squares point with a plain map
-//      (the box's one-APL level, masked by the hull of all its directions, was 131/85/57/52 % off at
-//      d = 1/2/5/10, plain 126/75/51/53 %: one point cannot stand for sources 4 cm apart);
-//   5. maps are the rays binned as in the builder (step 5), each ray to its source's APL in every level.
+//      (the box's one-APL level plain is 126/75/51/53 % off at d = 1/2/5/10, ShippedSetSuite/4; masked
+//      by the hull of all its directions it was no better in a trial: one point cannot stand for
+//      sources 4 cm apart);
+//   5. maps are the rays binned as in the builder (step 5): each source's flux binned once per map
+//      resolution as its rays are assigned, an APL's map the sum of its sources'.
 // Masked APLs add up exactly as the lights they stand for: APLs at one point with one mask are one light,
 // so one APL per source is the level (the placement study in docs/apl_sets.md left 303 of 512 APLs
 // empty and equalled the two-APL rows to 0.01 points).
 //
 // Cost: one pass over the rays to count the lines through each candidate, which ends at the first ray
-// that passes none (for any extended emitter, almost always the first: 4 096 rays are read); one to
-// assign the rays to the sources, again for each round that drops a source; one to gather each source's
-// rays; one to bin them. Memory: each ray's source (4 bytes) and direction (24 bytes, while the masks are
-// made). A set whose masks a bundle reader would refuse by default (apl_set.h: kMaxMaskCaps,
+// that passes none (for any extended emitter, almost always the first: 4 096 rays are read); one that
+// assigns each ray to a source and gathers its line, direction and binned flux there, again for each
+// round that drops a source. Memory: each ray's direction (24 bytes, while the masks are made) and each
+// source's flux at every level's resolution. A set whose masks a bundle reader would refuse by default (apl_set.h: kMaxMaskCaps,
 // kMaxMaskHullVertices, kMaxMaskTests) is not made.
 #pragma once
 
@@ -61,7 +63,8 @@ LUMX_NAMESPACE_BEGIN
 struct PointSourceOptions {
   bool enabled = true;           ///< look for point sources at all (AplBuildOptions::point_sources)
   /// A line passes through a point when it passes within this fraction of the bounding radius of it:
-  /// 1/1000 (70 µm on the 10 cm box with holes, whose rays pass their sources to 10⁻⁸ m, float rounding).
+  /// 1/1000 (75 µm on the 10 cm box with holes, whose lines pass their sources to float rounding:
+  /// PointSources.TheBoxWithHolesBecomesOneMaskedAplPerSource finds them within 1 µm).
   double tolerance = 1e-3;
   std::size_t min_rays = 500;    ///< lines a point needs to be a source (a DirectionMask needs ≥ 64 per beam)
   std::size_t max_sources = 64;  ///< more points than this: not "a few point sources"
@@ -191,26 +194,37 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
     return none(std::to_string(sources.size()) + " points have lines through them (at most " +
                 std::to_string(options.max_sources) + ")");
 
-  // ---- 2. every ray to the source its line passes nearest (the first of equals). A point a few eps
+  // ---- 2. every ray to the source its line passes nearest (the first of equals), its line, direction
+  // and flux gathered per source, the flux binned at every level's map resolution. A point a few eps
   // from a source passes some of its lines too (those within eps/δ rad of its direction from the
   // source), so a point kept in step 1 can be the nearest of few lines or none: such points are dropped
-  // and the rays assigned again, until every source is the nearest of min_rays lines.
+  // and the rays gathered again, until every source is the nearest of min_rays lines.
+  const auto counts_for = [&](std::size_t sources_found) {  // APLs per level: at most one per source
+    std::vector<std::size_t> counts;
+    for (std::size_t c : level_counts) {
+      const std::size_t n = std::min(c, sources_found);
+      if (counts.empty() || n > counts.back()) counts.push_back(n);
+    }
+    return counts;
+  };
   constexpr std::uint32_t kNoSource = UINT32_MAX;
-  std::vector<std::uint32_t> source_of;  // per ray of the file; kNoSource for a ray without flux
   std::vector<std::uint32_t> chunk_source;
   std::vector<LineFit> lines;
   std::vector<std::vector<glm::dvec3>> directions;
-  std::vector<double> source_flux;
-  std::vector<std::uint64_t> nearest_of;
-  const auto assign = [&](bool collect) {
+  std::vector<int> resolutions;                      // the levels' distinct map resolutions
+  std::vector<std::vector<std::vector<double>>> binned;  // per source and resolution, Σ flux per texel
+  const auto gather = [&] {
     const std::size_t n_src = sources.size();
-    nearest_of.assign(n_src, 0);
-    if (collect) {
-      source_of.clear();
-      lines.assign(n_src, LineFit{});
-      directions.assign(n_src, {});
-      source_flux.assign(n_src, 0.0);
-    }
+    resolutions.clear();
+    for (std::size_t c : counts_for(n_src))
+      if (std::find(resolutions.begin(), resolutions.end(), resolution(c)) == resolutions.end())
+        resolutions.push_back(resolution(c));
+    lines.assign(n_src, LineFit{});
+    directions.assign(n_src, {});
+    binned.assign(n_src, std::vector<std::vector<double>>(resolutions.size()));
+    for (auto& per_source : binned)
+      for (std::size_t r = 0; r < resolutions.size(); ++r)
+        per_source[r].assign(2 * std::size_t(resolutions[r]) * std::size_t(resolutions[r]), 0.0);
     detail::for_each_ray_chunk(
         rays, chunk_rays, threads,
         [&](std::size_t n) {
@@ -226,37 +240,38 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
             if (detail::line_passes(sources[q], o, w, eps, d) && d < best) best = d, chunk_source[i] = std::uint32_t(q);
           }
         },
-        [&](const RayChunk& c, std::uint64_t first) {
+        [&](const RayChunk& c, std::uint64_t first) {  // in file order: the sums do not depend on threads
           for (std::size_t i = 0; i < c.size(); ++i) {
+            if (!(c.flux[i] > 0)) continue;
             const std::uint32_t q = chunk_source[i];
-            if (q == kNoSource && c.flux[i] > 0) {
+            if (q == kNoSource) {
               missing = first + i;
               return false;
             }
-            if (q != kNoSource) ++nearest_of[q];
-            if (!collect) continue;
-            source_of.push_back(q);
-            if (q == kNoSource) continue;
             lines[q].add(c.position(i), c.direction(i), c.flux[i]);
             directions[q].push_back(glm::normalize(glm::dvec3(c.direction(i))));
-            source_flux[q] += double(c.flux[i]);
+            const glm::vec3 m = frame.map_direction(c.direction(i));
+            for (std::size_t r = 0; r < resolutions.size(); ++r) {
+              int x, y;
+              sphere_map::texel_of(m, resolutions[r], x, y);
+              binned[q][r][std::size_t(y) * 2 * std::size_t(resolutions[r]) + std::size_t(x)] += double(c.flux[i]);
+            }
           }
           return true;
         });
   };
   while (true) {  // each round drops a point at least, so at most max_sources rounds
-    assign(false);
+    gather();
     if (missing != UINT64_MAX)
       return none("ray " + std::to_string(missing) + "'s line passes none of the " + std::to_string(sources.size()) +
                   " sources");
     std::vector<glm::dvec3> kept;
     for (std::size_t q = 0; q < sources.size(); ++q)
-      if (nearest_of[q] >= options.min_rays) kept.push_back(sources[q]);
+      if (directions[q].size() >= options.min_rays) kept.push_back(sources[q]);
     if (kept.size() == sources.size()) break;
     if (kept.empty()) return none("no set of points is each the nearest of " + std::to_string(options.min_rays) + " lines");
     sources = std::move(kept);
   }
-  assign(true);
   const std::size_t S = sources.size();
 
   // ---- 3. each source at its rays' least-squares point (kept where that stays within eps), its mask
@@ -269,18 +284,15 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
     if (!m) return none("source " + std::to_string(s) + ": " + why);
     masks[s] = std::make_shared<const DirectionMask>(std::move(*m));
   }
+  std::vector<std::vector<glm::dvec3>>().swap(directions);
 
   // ---- 4. levels: cuts of a tree over the sources, at most one APL per source
-  std::vector<std::size_t> counts;
-  for (std::size_t c : level_counts) {
-    const std::size_t n = std::min(c, S);
-    if (counts.empty() || n > counts.back()) counts.push_back(n);
-  }
+  const std::vector<std::size_t> counts = counts_for(S);
   std::vector<std::vector<std::uint32_t>> apl_of(counts.size(), std::vector<std::uint32_t>(S));  // per level, source → APL
   {
     std::vector<glm::vec3> pos;
     std::vector<float> flux;
-    for (std::size_t s = 0; s < S; ++s) pos.emplace_back(sources[s]), flux.push_back(float(source_flux[s]));
+    for (std::size_t s = 0; s < S; ++s) pos.emplace_back(sources[s]), flux.push_back(float(lines[s].weight));
     // A tree only where some level has fewer APLs than sources (one source needs none).
     const ClusterTree tree = counts.front() < S ? build_cluster_tree(pos, flux, ClusterOptions{}) : ClusterTree{};
     const std::vector<std::vector<int>> cuts = counts.front() < S ? cut_cluster_tree(tree, counts) : std::vector<std::vector<int>>{};
@@ -305,12 +317,17 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
       }
     }
   }
+  // ---- 5. each APL: its sources' binned flux as intensity (step 5 of the builder), its place, its mask
   AplSet set;
   set.bounds = bounds;
+  double tests = 0;  // the masks' coverage work, against what a bundle reader accepts by default
   for (std::size_t k = 0; k < counts.size(); ++k) {
     AplLevel level;
     level.frame = frame;
     level.map_resolution = resolution(counts[k]);
+    const int R = level.map_resolution;
+    const std::size_t r = std::size_t(std::find(resolutions.begin(), resolutions.end(), R) - resolutions.begin());
+    const double to_intensity = 1.0 / sphere_map::texel_solid_angle(R);
     level.apls.resize(counts[k]);
     std::vector<std::vector<std::size_t>> members(counts[k]);
     for (std::size_t s = 0; s < S; ++s) members[apl_of[k][s]].push_back(s);
@@ -319,82 +336,37 @@ inline std::optional<AplSet> build_point_source_set(RaySource& rays, const std::
       const std::vector<std::size_t>& mine = members[a];
       if (mine.empty()) continue;  // check_apl_set reports it; a cut of the tree has none
       apl.parent = k == 0 ? -1 : int(apl_of[k - 1][mine.front()]);
+      std::vector<double> sum(binned[mine.front()][r]);
+      for (std::size_t j = 1; j < mine.size(); ++j)
+        for (std::size_t t = 0; t < sum.size(); ++t) sum[t] += binned[mine[j]][r][t];
+      apl.map = SphereMap(R, 1);
+      double flux = 0;
+      for (std::size_t t = 0; t < sum.size(); ++t) apl.map.values()[t] = float(sum[t] * to_intensity), flux += sum[t];
+      apl.flux = glm::dvec3(flux);
       if (mine.size() == 1) {
         apl.position = glm::vec3(sources[mine.front()]);
         apl.mask = masks[mine.front()];
+        const DirectionMask& m = *apl.mask;
+        if (m.caps().size() > kMaxMaskCaps) return none("a source's mask has " + std::to_string(m.caps().size()) + " caps");
+        for (const DirectionMask::Cap& c : m.caps())
+          if (c.hull.size() > kMaxMaskHullVertices)
+            return none("a source's mask has a hull of " + std::to_string(c.hull.size()) + " vertices");
+        tests += m.coverage_tests(R, mask_coverage_subsamples(R)) + 2.0 * R * R;
         continue;
       }
       LineFit all;
       glm::dvec3 mean(0.0);
-      double weight = 0;
-      for (std::size_t s : mine) {
-        all.add(lines[s]);
-        mean += source_flux[s] * sources[s], weight += source_flux[s];
-      }
-      mean = weight > 0 ? mean / weight : sources[mine.front()];
-      const glm::dvec3 x = all.solve(mean, sphere_map::texel_solid_angle(level.map_resolution));
+      for (std::size_t s : mine) all.add(lines[s]), mean += lines[s].weight * sources[s];
+      mean = all.weight > 0 ? mean / all.weight : sources[mine.front()];
+      const glm::dvec3 x = all.solve(mean, sphere_map::texel_solid_angle(R));
       apl.position = glm::vec3(glm::length(x - bounds.center) <= 1.001 * bounds.radius + 1e-9 ? x : mean);
     }
     set.levels.push_back(std::move(level));
   }
-  std::vector<std::vector<glm::dvec3>>().swap(directions);
-  // What a bundle reader accepts by default (apl_set.h), so that the set can be written and read back.
-  double tests = 0;
-  for (const AplLevel& level : set.levels)
-    for (std::size_t a = 0; a < level.apls.size(); ++a) {
-      const std::shared_ptr<const DirectionMask>& m = level.apls[a].mask;
-      if (!m) continue;
-      if (m->caps().size() > kMaxMaskCaps) return none("a source's mask has " + std::to_string(m->caps().size()) + " caps");
-      for (const DirectionMask::Cap& c : m->caps())
-        if (c.hull.size() > kMaxMaskHullVertices)
-          return none("a source's mask has a hull of " + std::to_string(c.hull.size()) + " vertices");
-      tests += m->coverage_tests(level.map_resolution, kMaskCoverageSubsamples) +
-               2.0 * level.map_resolution * level.map_resolution;
-    }
   if (tests > kMaxMaskTests)
     return none("the masks' coverage would take " + std::to_string(tests) + " tests (at most " +
                 std::to_string(kMaxMaskTests) + ")");
-
-  // ---- 5. maps: each ray's flux, as intensity, in its source's APL of every level (file order)
-  std::vector<std::vector<double>> sums(set.levels.size());
-  for (std::size_t k = 0; k < set.levels.size(); ++k)
-    sums[k].assign(set.levels[k].apls.size() * 2 * std::size_t(set.levels[k].map_resolution) *
-                       std::size_t(set.levels[k].map_resolution), 0.0);
-  {
-    RayChunk c;
-    std::uint64_t index = 0;
-    rays.rewind();
-    while (rays.next(c, chunk_rays))
-      for (std::size_t i = 0; i < c.size(); ++i, ++index) {
-        const std::uint32_t s = index < source_of.size() ? source_of[index] : kNoSource;
-        if (s == kNoSource) continue;
-        const glm::vec3 m = frame.map_direction(c.direction(i));
-        for (std::size_t k = 0; k < set.levels.size(); ++k) {
-          const int R = set.levels[k].map_resolution;
-          int x, y;
-          sphere_map::texel_of(m, R, x, y);
-          sums[k][std::size_t(apl_of[k][s]) * 2 * std::size_t(R) * std::size_t(R) + std::size_t(y) * 2 * std::size_t(R) +
-                  std::size_t(x)] += double(c.flux[i]);
-        }
-      }
-  }
-  for (std::size_t k = 0; k < set.levels.size(); ++k) {
-    AplLevel& level = set.levels[k];
-    const int R = level.map_resolution;
-    const std::size_t T = 2 * std::size_t(R) * std::size_t(R);
-    const double to_intensity = 1.0 / sphere_map::texel_solid_angle(R);
-    for (std::size_t a = 0; a < level.apls.size(); ++a) {
-      Apl& apl = level.apls[a];
-      apl.map = SphereMap(R, 1);
-      double flux = 0;
-      for (std::size_t t = 0; t < T; ++t) {
-        apl.map.values()[t] = float(sums[k][a * T + t] * to_intensity);
-        flux += sums[k][a * T + t];
-      }
-      apl.flux = glm::dvec3(flux);
-      refresh_coverage(apl, level.frame);
-    }
-  }
+  for (AplLevel& level : set.levels) refresh_coverages(level);
   rep.sources = S;
   return set;
 }

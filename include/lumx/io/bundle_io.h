@@ -134,7 +134,7 @@ struct BundleLimits {
   std::size_t max_masks = 4096;             ///< beam masks in a manifest
   std::size_t max_caps_per_mask = kMaxMaskCaps;            ///< caps in one mask (256)
   std::size_t max_hull_vertices = kMaxMaskHullVertices;    ///< vertices of one cap's hull (4 096)
-  /// The reader computes each masked APL's coverage (8 × 8 sub-directions a texel, each tested against
+  /// The reader computes each masked APL's coverage (mask_coverage_subsamples(R)² sub-directions a texel, each tested against
   /// every cap in O(log vertices)); a manifest whose masks would take more tests than this over its
   /// levels at their full resolutions is refused (2^31: a few seconds), so a hostile manifest cannot make loading hang.
   std::uint64_t max_mask_tests = std::uint64_t(kMaxMaskTests);

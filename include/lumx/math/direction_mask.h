@@ -159,7 +159,7 @@ class DirectionMask {
   /// The lit fraction of every texel of a map of square resolution R whose directions turn into the
   /// mask's frame by `map_to_mask` (a rotation), from sub × sub equal-area sub-directions per texel.
   SphereMap coverage(int resolution, const glm::mat3& map_to_mask, int sub = 4) const {
-    if (sub < 1 || sub > 64) throw std::invalid_argument("DirectionMask::coverage: sub " + std::to_string(sub) + " outside [1, 64]");
+    if (sub < 1 || sub > 256) throw std::invalid_argument("DirectionMask::coverage: sub " + std::to_string(sub) + " outside [1, 256]");
     SphereMap out(resolution, 1);
     const float inv = 1.0f / float(sub * sub);
     for (int y = 0; y < resolution; ++y)

@@ -406,7 +406,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
       // per masked APL.
       std::set<int> distinct(l.mask.begin(), l.mask.end());
       for (int q : distinct)
-        if (q >= 0) mask_tests += m.masks[std::size_t(q)]->coverage_tests(l.map_resolution, kMaskCoverageSubsamples);
+        if (q >= 0) mask_tests += m.masks[std::size_t(q)]->coverage_tests(l.map_resolution, mask_coverage_subsamples(l.map_resolution));
       for (int q : l.mask)
         if (q >= 0) mask_tests += 2.0 * l.map_resolution * l.map_resolution;
       if (mask_tests > double(limits.max_mask_tests))
