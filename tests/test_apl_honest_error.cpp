@@ -177,23 +177,22 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
   // BakePasses.StopsAsSoonAs… and the ResolutionFit tests.
   GTEST_SKIP() << "release build only";
 #endif
-  const std::unique_ptr<AnalyticEmitter> em = suite_emitter(GetParam() % 5);
-  auto rays = em->source(kSuiteRays, 11 + std::uint64_t(GetParam()));
+  // 7: the box with holes as clustered APLs (point sources off), on the rays of 4.
+  const bool clustered_box = GetParam() == 7;
+  const int emitter = clustered_box ? 4 : GetParam() % 5;
+  const std::unique_ptr<AnalyticEmitter> em = suite_emitter(emitter);
+  auto rays = em->source(kSuiteRays, 11 + std::uint64_t(emitter == 4 ? 4 : GetParam()));
   AplBuildOptions bo;
   bo.threads = 2;
-  // The box's point sources as masked APLs (apl/point_sources.h) are 2.7-3.2 % off at points when built
-  // from the even rays, and the held-out estimate puts them at 2.5-22.6 %: at d = 1 and 10 one patch
-  // each whose centre the pilot's masks, from fewer rays, call dark (docs/apl_sets.md, "What the table
-  // stores"). The estimator is validated here on the clustered set, as built before point sources.
-  bo.point_sources.enabled = GetParam() % 5 != 4;
+  bo.point_sources.enabled = !clustered_box;
   AplErrorOptions eo;
-  const bool fit = GetParam() < 5;
+  const bool fit = GetParam() < 5 || clustered_box;
   ResolutionChoice choice;
   const AplErrorReport r =
       fit ? evaluate_held_out_fitted(*rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo, rays->info().ray_count)); },
                                      eo, &choice)
           : evaluate_held_out(*rays, [&](RaySource& train) { return build_apl_set(train, bo); }, eo);
-  const ExactOnSpheres exact = exact_on_spheres(*em, r.reference.spheres, GetParam() % 5 >= 2 ? 8 : 5);  // lobes narrower than a patch: 8 x 8
+  const ExactOnSpheres exact = exact_on_spheres(*em, r.reference.spheres, emitter >= 2 ? 8 : 5);  // lobes narrower than a patch: 8 x 8
   std::printf("%s, %llu rays, %s\n", em->name().c_str(), (unsigned long long)rays->info().ray_count,
               fit ? "resolutions fitted on rays 1, 5, 9, ..., graded on rays 3, 7, 11, ..." : "built resolutions");
   std::vector<const LevelErrors*> rows;
@@ -232,21 +231,29 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
     std::printf(" %s %.1f/%.1f", s.centred ? "centre" : "mean", 100 * s.centring_shift, 100 * s.pilot_shape_error);
   std::printf("\n");
   // What the shape check decides, where it matters: the spots' lobes, a few patches wide, are centred
-  // from d = 1 on (their 512-APL levels, 2–7 % off at points, are 13–75 % off the exact patch means there); the box's beams, whose
-  // sharp borders the pilot blurs as the levels do, keep their patch means at every d.
+  // from d = 1 on (their 512-APL levels, 2–7 % off at points, are 13–75 % off the exact patch means
+  // there); the box's beams as masked APLs, whose borders the pilot holds as geometry, are centred at
+  // every d (its 2-APL level is 55–67 % off the exact patch means); as clustered APLs, whose sharp
+  // borders the pilot blurs as the levels do, they keep their patch means at every d.
   for (const SphereReference& s : r.reference.sphere) {
     if (GetParam() == 2 || GetParam() == 3) {
       EXPECT_TRUE(s.relative_distance < 1 || s.centred) << s.relative_distance;
     }
     if (GetParam() == 4) {
+      EXPECT_TRUE(r.levels.back().masked);
+      EXPECT_TRUE(s.centred) << s.relative_distance;
+    }
+    if (clustered_box) {
+      EXPECT_FALSE(r.levels.back().masked);
       EXPECT_FALSE(s.centred) << s.relative_distance;
     }
   }
 }
 
-// 0–4: maps at the resolution fitted on held-out rays (the default of lumx build); 5, 6: the disk and the
-// rectangle at the builder's resolution, finer than the patches.
-INSTANTIATE_TEST_SUITE_P(Emitters, HonestErrorSuite, ::testing::Range(0, 7));
+// 0–4: maps at the resolution fitted on held-out rays (the default of lumx build; 4, the box with holes,
+// as point sources behind apertures: masked APLs); 5, 6: the disk and the rectangle at the builder's
+// resolution, finer than the patches; 7: the box as clustered APLs (point sources off), fitted.
+INSTANTIATE_TEST_SUITE_P(Emitters, HonestErrorSuite, ::testing::Range(0, 8));
 
 // What lumx build ships (every ray, resolutions fitted on held-out rays) against the exact irradiance at
 // the patch centres, per level and distance: the figures the targets are stated for.
@@ -1268,45 +1275,43 @@ TEST(SpotStudy, DISABLED_WideTwoScaleForSparseMaps) {
 }
 }  // namespace
 
-// The held-out estimate of the box's masked level (docs/apl_sets.md, "What the table stores"): the set
-// evaluate_held_out_fitted grades (built from the even rays, point sources as masked APLs) against the
-// exact irradiance at the patch centres, beside the estimate with the noise removed, and the patch of
-// sphere d = 1 farthest from its centred reference. Printed, and checked against the documented rows
-// (to 0.1 points). Off by default (about 5 s):
+// The held-out estimate of the box's masked level over 20 rays (docs/apl_sets.md, "What the table
+// stores"): per seed, the level evaluate_held_out_fitted grades (built from the even rays, point sources
+// as masked APLs) against the exact irradiance at the patch centres, beside the estimate with the noise
+// removed ('<': unresolved) and its upper bound, %. Counted: spheres where the upper bound is below 3/4 of
+// the truth (the estimate flatters), and spheres resolved more than 25 % from it. Printed, and checked
+// against the documented counts. Off by default (about 80 s):
 //   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*HeldOutEstimateOfTheMaskedLevel*'
 TEST(PinholeBoxStudy, DISABLED_HeldOutEstimateOfTheMaskedLevel) {
-  const std::unique_ptr<AnalyticEmitter> em = suite_emitter(4);
-  auto rays = em->source(kSuiteRays, 15);
-  AplBuildOptions bo;
-  bo.threads = 2;
-  ResolutionChoice choice;
-  const AplErrorReport r = evaluate_held_out_fitted(
-      *rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo, rays->info().ray_count)); },
-      AplErrorOptions{}, &choice);
-  ASSERT_EQ(r.levels.size(), 2u);
-  const LevelErrors& row = r.levels[1];
-  ASSERT_TRUE(row.masked);
-  const ExactOnSpheres exact = exact_on_spheres(*em, r.reference.spheres, 1);
-  const std::vector<double> truth = true_errors(exact.at_centre, row);
-  const double documented[2][6] = {{2.8, 2.7, 3.0, 3.0, 3.0, 3.2}, {2.5, 4.7, 17.7, 4.1, 5.6, 22.6}};
-  std::printf("masked level, R %d: point error against the exact irradiance / held-out estimate, noise removed, %%:",
-              row.map_resolution);
-  for (std::size_t s = 0; s < truth.size(); ++s) {
-    const double e = row.errors[s].relative_rmse_noise_removed;
-    std::printf(" %.1f/%.1f%s", 100 * truth[s], 100 * e, row.errors[s].resolved ? "" : "<");
-    EXPECT_NEAR(100 * truth[s], documented[0][s], 0.1) << s;
-    EXPECT_NEAR(100 * e, documented[1][s], 0.1) << s;
+  const PinholeBox box = pinhole_box();
+  int flatters = 0, resolved_off = 0, spikes = 0, spheres = 0;
+  for (std::uint64_t seed = 11; seed < 31; ++seed) {
+    auto rays = box.source(kSuiteRays, seed);
+    AplBuildOptions bo;
+    bo.threads = 2;
+    ResolutionChoice choice;
+    const AplErrorReport r = evaluate_held_out_fitted(
+        *rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo, rays->info().ray_count)); },
+        AplErrorOptions{}, &choice);
+    const LevelErrors& row = r.levels.back();
+    ASSERT_TRUE(row.masked) << seed;
+    const ExactOnSpheres exact = exact_on_spheres(box, r.reference.spheres, 1);
+    const std::vector<double> truth = true_errors(exact.at_centre, row);
+    std::printf("seed %2d, R %d:", int(seed), row.map_resolution);
+    for (std::size_t s = 0; s < truth.size(); ++s) {
+      const IrradianceErrors& e = row.errors[s];
+      std::printf(" %4.1f/%4.1f%s/%4.1f", 100 * truth[s], 100 * e.relative_rmse_noise_removed, e.resolved ? " " : "<",
+                  100 * e.noise_removed_upper);
+      ++spheres;
+      spikes += truth[s] > 0.1;
+      flatters += e.noise_removed_upper < 0.75 * truth[s];
+      resolved_off += e.resolved && std::abs(e.relative_rmse_noise_removed - truth[s]) > 0.25 * truth[s];
+    }
+    std::printf("\n");
   }
-  // The patch of sphere d = 1 whose model value is farthest from the centred reference.
-  const std::vector<double>& ref = r.reference.sphere[2].irradiance;
-  double mean = 0;
-  for (double v : ref) mean += v / double(ref.size());
-  std::size_t worst = 0;
-  for (std::size_t p = 0; p < ref.size(); ++p)
-    if (std::abs(row.irradiance[2][p] - ref[p]) > std::abs(row.irradiance[2][worst] - ref[worst])) worst = p;
-  std::printf("\n  d = 1, patch %zu: model %.2f, centred reference %.2f, exact %.2f (÷ the reference's mean)\n", worst,
-              row.irradiance[2][worst] / mean, ref[worst] / mean, exact.at_centre[2][worst] / mean);
-  EXPECT_NEAR(row.irradiance[2][worst] / mean, 3.85, 0.01);
-  EXPECT_NEAR(ref[worst] / mean, 0.0, 0.01);
-  EXPECT_NEAR(exact.at_centre[2][worst] / mean, 3.81, 0.01);
+  std::printf("%d spheres, %d with the truth above 10 %%: the upper bound below 3/4 of the truth at %d, resolved and "
+              "more than 25 %% off at %d\n", spheres, spikes, flatters, resolved_off);
+  EXPECT_EQ(spikes, 12);
+  EXPECT_EQ(flatters, 6);
+  EXPECT_EQ(resolved_off, 3);
 }

@@ -357,3 +357,126 @@ TEST(PointSources, FromCapsRefusesWhatIsNoConvexHull) {
   EXPECT_THROW(DirectionMask::from_caps({wide}), std::invalid_argument);
   EXPECT_THROW(DirectionMask::from_caps({}), std::invalid_argument);
 }
+
+TEST(MaskedReference, APilotTakesTheBordersTheGradedSetsRaysProveLit) {
+  // pilot_with_known_borders: the pilot of a held-out evaluation, from a quarter of the rays, joins the
+  // masks of the graded set (from the even half) at the same sources. Every direction either mask holds
+  // is then lit in the pilot, and nothing else; every even ray's direction is in its set's hull, and
+  // some of them lie outside the quarter's.
+  const PinholeBox box = two_source_box();
+  auto rays = box.source(kSanitized ? 300000 : 1000000, 31);
+  AplBuildOptions bo;
+  bo.threads = 2;
+  AplSet graded, from_quarter;
+  {
+    RayHalf even(*rays, 0);
+    graded = build_apl_set(even, bo);
+    RayHalf odd(*rays, 1);
+    RayHalf quarter(odd, 0);
+    from_quarter = build_apl_set(quarter, bo);
+  }
+  const AplSet pilot = centring_pilot(from_quarter);
+  ASSERT_TRUE(pilot.levels.at(0).has_masks());
+  ASSERT_TRUE(graded.levels.back().has_masks());
+  const AplSet joined = pilot_with_known_borders(pilot, graded);
+  const AplLevel &p = pilot.levels[0], &j = joined.levels[0], &g = graded.levels.back();
+  ASSERT_EQ(j.size(), p.size());
+  auto nearest = [](const AplLevel& l, const glm::vec3& x) {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < l.size(); ++i)
+      if (glm::length(l.apls[i].position - x) < glm::length(l.apls[best].position - x)) best = i;
+    return best;
+  };
+  // (A few even rays fall outside their own set's mask: hull vertices, rounded between the float rays and
+  // the double hull.)
+  std::size_t even_rays = 0, lit_by_graded_only = 0, lost = 0;
+  RayHalf even(*rays, 0);
+  RayChunk c;
+  even.rewind();
+  while (even.next(c, 1 << 16))
+    for (std::size_t r = 0; r < c.size(); ++r) {
+      const glm::dvec3 w(c.direction(r)), start(c.position(r));
+      // The source whose line this is: the nearer of the two to the ray's line.
+      std::size_t s = 0;
+      double best = 1e300;
+      for (std::size_t q = 0; q < 2; ++q) {
+        const glm::dvec3 v = kSources[q] - start;
+        const double d = glm::length(v - glm::dot(v, w) * w);
+        if (d < best) best = d, s = q;
+      }
+      const std::size_t pi = nearest(p, glm::vec3(kSources[s]));
+      const bool in_g = g.apls[nearest(g, glm::vec3(kSources[s]))].mask->contains(w);
+      ++even_rays;
+      lit_by_graded_only += in_g && !p.apls[pi].mask->contains(w);
+      lost += in_g && !j.apls[pi].mask->contains(w);
+    }
+  EXPECT_GT(even_rays, 40000u);
+  EXPECT_GT(lit_by_graded_only, 0u);  // the quarter's hulls are short of the even rays' borders
+  EXPECT_EQ(lost, 0u);                // joined, none is
+  // Random directions: the joined mask is the union of the two, nothing more.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n01;
+  std::size_t only_graded = 0;
+  for (int t = 0; t < 200000; ++t) {
+    glm::dvec3 w(n01(rng), n01(rng), n01(rng));
+    w = glm::normalize(w);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const bool in_g = g.apls[nearest(g, p.apls[i].position)].mask->contains(w);
+      const bool in_p = p.apls[i].mask->contains(w);
+      ASSERT_EQ(j.apls[i].mask->contains(w), in_g || in_p) << t;
+      only_graded += in_g && !in_p;
+    }
+  }
+  EXPECT_GT(only_graded, 0u);
+  // Coverage computed for the joined mask: never below the pilot's own.
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    ASSERT_EQ(j.apls[i].coverage.resolution(), p.apls[i].coverage.resolution());
+    for (std::size_t t = 0; t < p.apls[i].coverage.values().size(); ++t)
+      EXPECT_GE(j.apls[i].coverage.values()[t], p.apls[i].coverage.values()[t]) << i << " " << t;
+  }
+  // Sources elsewhere join nothing; a pilot without masks is left alone.
+  AplSet moved = graded;
+  for (AplLevel& l : moved.levels)
+    for (Apl& a : l.apls) a.position += glm::vec3(0.01f, 0, 0);
+  const AplSet apart = pilot_with_known_borders(pilot, moved);
+  for (std::size_t i = 0; i < p.size(); ++i) EXPECT_EQ(apart.levels[0].apls[i].mask, p.apls[i].mask);
+  AplBuildOptions plain = bo;
+  plain.point_sources.enabled = false;
+  RayHalf odd(*rays, 1);
+  const AplSet clustered = centring_pilot(build_apl_set(odd, plain));
+  ASSERT_FALSE(clustered.levels[0].has_masks());
+  const AplSet same = pilot_with_known_borders(clustered, graded);
+  EXPECT_EQ(same.levels[0].apls.size(), clustered.levels[0].apls.size());
+  EXPECT_FALSE(same.levels[0].has_masks());
+}
+
+TEST(MaskedReference, AMaskedPilotScalesAPatchAndItsNoise) {
+  // detail::centre_patch: a plain pilot adds P(c) − P̄ (floored at 0); a masked one scales by P(c) / P̄,
+  // the variance by its square and the halves alike; a patch a masked pilot leaves dark keeps its mean.
+  SphereReference sr;
+  sr.irradiance = {2, 2, 2, 1};
+  sr.variance = {0.5, 0.5, 0.5, 0.5};
+  sr.half_even = {1.5, 1.5, 1.5, 1};
+  sr.half_odd = {2.5, 2.5, 2.5, 1};
+  SphereReference plain = sr;
+  detail::centre_patch(sr, 0, 3.0, 1.5, true);
+  EXPECT_DOUBLE_EQ(sr.irradiance[0], 4.0);
+  EXPECT_DOUBLE_EQ(sr.variance[0], 2.0);
+  EXPECT_DOUBLE_EQ(sr.half_even[0], 3.0);
+  EXPECT_DOUBLE_EQ(sr.half_odd[0], 5.0);
+  detail::centre_patch(sr, 1, 0.0, 0.7, true);  // the pilot's border misses the centre
+  EXPECT_DOUBLE_EQ(sr.irradiance[1], 0.0);
+  EXPECT_DOUBLE_EQ(sr.variance[1], 0.0);
+  detail::centre_patch(sr, 2, 0.0, 0.0, true);  // dark throughout in the pilot: the mean stays
+  EXPECT_DOUBLE_EQ(sr.irradiance[2], 2.0);
+  EXPECT_DOUBLE_EQ(sr.variance[2], 0.5);
+  detail::refresh_noise_floors(sr);
+  const double mean = (4.0 + 0.0 + 2.0 + 1.0) / 4, var = (2.0 + 0.0 + 0.5 + 0.5) / 4;
+  EXPECT_DOUBLE_EQ(sr.noise_floor, std::sqrt(var) / mean);
+  detail::centre_patch(plain, 0, 3.0, 1.5, false);
+  detail::centre_patch(plain, 3, 0.0, 1.5, false);
+  EXPECT_DOUBLE_EQ(plain.irradiance[0], 3.5);
+  EXPECT_DOUBLE_EQ(plain.variance[0], 0.5);
+  EXPECT_DOUBLE_EQ(plain.irradiance[3], 0.0);  // 1 + 0 − 1.5, floored
+  EXPECT_DOUBLE_EQ(plain.variance[3], 0.5);
+}

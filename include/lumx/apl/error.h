@@ -831,6 +831,7 @@ struct AplErrorReport {
 };
 
 inline AplSet centring_pilot(const AplSet& set, double sigma = 0);
+inline AplSet pilot_with_known_borders(AplSet pilot, const AplSet& lit);
 /// Whether the held-out evaluators centre the reference (checked_centred_reference) for these options:
 /// one point per patch (the levels queried at the patch centres) and quarters within the spheres' limit.
 inline bool centring_applies(const AplErrorOptions& o) {
@@ -840,7 +841,7 @@ inline double centring_pilot_sigma(int patch_resolution);
 inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& ref, const ReferenceIrradiance& fine,
                                                      const AplSet& pilot, const AplErrorOptions& options);
 inline ReferenceIrradiance centred_reference(const ReferenceIrradiance& ref, const AplSet& pilot,
-                                             const AplErrorOptions& options, int k = 4);
+                                             const AplErrorOptions& options, int k = 0);
 
 /// Gathers the reference from `rays` (one pass) around `set.bounds` and evaluates every level and the far
 /// field. With a `pilot` (centring_pilot of a set built from rays `set` never saw, of width
@@ -878,15 +879,17 @@ inline AplErrorReport evaluate_apl_errors(const AplSet& set, RaySource& rays, co
 /// (RaySource& → AplSet; e.g. one level of 64 APLs, built as the set was) makes the pilot from the even
 /// rays and the levels are graded on the odd ones, so the pilot shares no ray with the rays that check
 /// and grade. Otherwise (no centring for these options, or no pilot from the even rays: too few, or no
-/// flux) every ray grades, uncentred.
+/// flux) every ray grades, uncentred. `lit_borders`: a set built from other rays of this luminaire whose
+/// beam masks the pilot's join (pilot_with_known_borders; the held-out evaluators pass the graded set).
 template <class Build>
 AplErrorReport evaluate_independent(const AplSet& set, RaySource& rays, Build&& build_pilot,
-                                    const AplErrorOptions& options = {}) {
+                                    const AplErrorOptions& options = {}, const AplSet* lit_borders = nullptr) {
   if (!centring_applies(options)) return evaluate_apl_errors(set, rays, options);
   AplSet pilot;
   try {
     RayHalf even(rays, 0);
     pilot = centring_pilot(build_pilot(static_cast<RaySource&>(even)), centring_pilot_sigma(options.patch_resolution));
+    if (lit_borders) pilot = pilot_with_known_borders(std::move(pilot), *lit_borders);
   } catch (const std::invalid_argument&) {
     return evaluate_apl_errors(set, rays, options);
   }
@@ -912,7 +915,7 @@ AplErrorReport evaluate_held_out(RaySource& rays, Build&& build, const AplErrorO
   // The odd rays are to this set what another run's rays are: the pilot from rays 1, 5, 9, …, the
   // grading on rays 3, 7, 11, ….
   RayHalf odd(rays, 1);
-  return evaluate_independent(set, odd, build, options);
+  return evaluate_independent(set, odd, build, options, &set);
 }
 
 // ---- Map resolution by held-out error
@@ -1492,6 +1495,46 @@ inline AplSet centring_pilot(const AplSet& set, double sigma) {
   return pilot;
 }
 
+/// A masked pilot (centring_pilot) whose every mask also takes the caps of the same source's mask in
+/// `lit`, a set built from other rays of the same luminaire (the graded set, in the held-out
+/// evaluators): each masked APL of the pilot's level joins the caps of the masked APL of `lit` nearest it,
+/// when that lies within 1/1000 of the bounding radius (PointSourceOptions::tolerance: the same source),
+/// and its coverage is computed afresh. Why: a beam mask is the hull of the directions of real rays
+/// through an aperture, so it lies inside the true beam (convex apertures; apl/point_sources.h), and is
+/// short of the beam's border by a sliver that shrinks as the rays grow (about (2k/3)·ln n / n of a
+/// k-sided hole). A pilot from a quarter of the rays has the wider sliver, and a patch centre the graded
+/// level rightly lights there was called dark by it: in the box with holes, one patch of 512 made the
+/// estimate 17.7 % where the level is 3.0 % off at points (docs/apl_sets.md, "What the table stores").
+/// Joined, the pilot calls lit every direction either set's rays prove lit, which shares no noise with
+/// the graded level (that a direction inside a hull of real rays is lit is a fact, not an estimate); what
+/// it cannot see is the graded level's own sliver beyond both hulls. Only for `lit` built from rays of the
+/// luminaire the pilot's rays come from: a set's masks are taken as true. A pilot without masks is
+/// returned as it is.
+inline AplSet pilot_with_known_borders(AplSet pilot, const AplSet& lit) {
+  if (pilot.levels.empty() || !pilot.levels[0].has_masks()) return pilot;
+  const AplLevel* known = nullptr;  // the level of `lit` with the most masked APLs (one per source)
+  std::size_t most = 0;
+  for (const AplLevel& l : lit.levels) {
+    const std::size_t n = std::size_t(std::count_if(l.apls.begin(), l.apls.end(), [](const Apl& a) { return bool(a.mask); }));
+    if (n > most) most = n, known = &l;
+  }
+  if (!known) return pilot;
+  const double same = 1e-3 * std::max(pilot.bounds.radius, lit.bounds.radius);
+  AplLevel& level = pilot.levels[0];
+  for (Apl& a : level.apls) {
+    if (!a.mask) continue;
+    const Apl* match = nullptr;
+    for (const Apl& b : known->apls)
+      if (b.mask && (!match || glm::length(b.position - a.position) < glm::length(match->position - a.position))) match = &b;
+    if (!match || !(double(glm::length(match->position - a.position)) <= same) || match->mask == a.mask) continue;
+    std::vector<DirectionMask::Cap> caps = a.mask->caps();
+    caps.insert(caps.end(), match->mask->caps().begin(), match->mask->caps().end());
+    a.mask = std::make_shared<const DirectionMask>(DirectionMask::from_caps(std::move(caps)));
+  }
+  refresh_coverages(level);
+  return pilot;
+}
+
 /// The width (rad) of the pilot that centres a grading reference on patches of resolution R_patch
 /// (centring_pilot): 3/8 of a patch's width √(4π/N). Narrower, the pilot's own noise swamps the
 /// reference's: with σ = 1.5 texels of R 128 maps (3/16 of an R 16 patch) and 250 000 rays behind each,
@@ -1522,6 +1565,39 @@ inline std::vector<std::vector<double>> pilot_on_patches(const AplSet& pilot, co
   return evaluate_level(pilot, 0, at, o).irradiance;
 }
 
+namespace detail {
+/// Moves patch p of `sr` from its mean to its centre by a pilot's value there (`centre`) and its mean over
+/// the patch (`mean`). Plain pilots add the difference, E_c = max(0, E + P(c) − P̄) (centred_reference).
+/// A masked pilot's shape within a patch is a border times a smooth intensity, so it scales instead:
+/// E_c = E · P(c) / P̄, with the variance × (P(c) / P̄)² and the halves scaled alike. A border patch
+/// lit over a fraction f by the pilot and at its centre is moved by about E·(1/f − 1), which the
+/// pilot's own intensity noise (an R 8 map from a quarter of the rays, a few % a texel) no longer
+/// enters: added, its intensity error times (1 − f) went into every border patch, and the box's masked
+/// level, 3.0 % off at points at d = 1, was estimated at 5.1 % (PinholeBoxStudy). A patch the pilot
+/// leaves dark throughout keeps its mean.
+inline void centre_patch(SphereReference& sr, std::size_t p, double centre, double mean, bool masked) {
+  if (masked && mean > 0) {
+    const double g = centre / mean;
+    sr.irradiance[p] *= g;
+    sr.variance[p] *= g * g;
+    if (p < sr.half_even.size()) sr.half_even[p] *= g;
+    if (p < sr.half_odd.size()) sr.half_odd[p] *= g;
+  } else if (!masked) {
+    sr.irradiance[p] = std::max(0.0, sr.irradiance[p] + centre - mean);
+  }
+}
+
+/// σ and the halves' σ of a sphere afresh after its patches moved (centre_patch scales variances).
+inline void refresh_noise_floors(SphereReference& sr) {
+  double sum = 0, var = 0;
+  for (std::size_t p = 0; p < sr.irradiance.size(); ++p) sum += sr.irradiance[p], var += sr.variance[p];
+  const double n = double(sr.irradiance.size());
+  sr.noise_floor = sum > 0 ? std::sqrt(var / n) / (sum / n) : NAN;
+  if (sr.half_even.size() == sr.irradiance.size() && sr.half_odd.size() == sr.irradiance.size())
+    sr.split_noise_floor = noise_floor(sr.half_even, sr.half_odd);
+}
+}  // namespace detail
+
 /// The reference moved from patch means to patch centres, where fit_map_resolutions evaluates its
 /// candidates: E_c = max(0, E + P(centre) − P̄), with P a pilot model (level 0 of `pilot`, e.g.
 /// centring_pilot of a set built from other rays) and P̄ its mean over the patch (k × k sub-points).
@@ -1536,20 +1612,27 @@ inline std::vector<std::vector<double>> pilot_on_patches(const AplSet& pilot, co
 /// rays, independent of them, so each candidate's own point noise is still seen in full; what remains is
 /// the pilot's error in that shape. The variance and
 /// halves are left as they are; a patch the centring would take below 0 is set to 0 (irradiance is never
-/// negative), which can lift a dark patch by a little. The pilot must not share rays with the candidates
+/// negative), which can lift a dark patch by a little. A masked pilot scales instead of adding
+/// (detail::centre_patch), with the variance and halves scaled alike. The pilot must not share rays with the candidates
 /// (evaluate_held_out_fitted builds it from the fitting rays): a pilot made from a candidate's own rays
 /// would cancel that candidate's noise within each patch, and the fit would favour whatever resembles
-/// it. Throws std::invalid_argument unless 2 ≤ k ≤ 16.
+/// it (a masked pilot's borders may join the candidates' masks: pilot_with_known_borders). k = 0: 4,
+/// or 16 for a masked pilot. Throws std::invalid_argument unless k is 0 or 2 ≤ k ≤ 16.
 inline ReferenceIrradiance centred_reference(const ReferenceIrradiance& ref, const AplSet& pilot,
                                              const AplErrorOptions& options, int k) {
-  if (k < 2 || k > 16) throw std::invalid_argument("centred_reference: k must be in [2, 16]");
+  // By default 4 × 4 points a patch; 16 × 16 for a masked pilot, whose patches hold sharp borders (the
+  // lit share of a patch to 1/256, as checked_centred_reference takes it).
+  if (k == 0) k = pilot.levels.at(0).has_masks() ? 16 : 4;
+  if (k < 2 || k > 16) throw std::invalid_argument("centred_reference: k must be 0 or in [2, 16]");
   ReferenceIrradiance out = ref;
   const std::vector<std::vector<double>> at_centre = pilot_on_patches(pilot, ref, options, 1),
                                          mean = pilot_on_patches(pilot, ref, options, k);
+  const bool masked = pilot.levels.at(0).has_masks();
   for (std::size_t s = 0; s < out.sphere.size(); ++s) {
-    std::vector<double>& e = out.sphere[s].irradiance;
-    for (std::size_t p = 0; p < e.size(); ++p) e[p] = std::max(0.0, e[p] + at_centre[s][p] - mean[s][p]);
-    out.sphere[s].centred = true;
+    SphereReference& sr = out.sphere[s];
+    for (std::size_t p = 0; p < sr.irradiance.size(); ++p) detail::centre_patch(sr, p, at_centre[s][p], mean[s][p], masked);
+    if (masked) detail::refresh_noise_floors(sr);
+    sr.centred = true;
   }
   return out;
 }
@@ -1582,15 +1665,15 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
   // The quarters' means at 2 × 2 points each: the same 4 × 4 points per patch as centred_reference's P̄.
   // A masked pilot's patches hold sharp borders, whose lit share 2 × 2 points find to a quarter: 8 × 8
   // points a quarter there (docs/apl_sets.md, "What the table stores").
-  const std::vector<std::vector<double>> quarters =
-      pilot_on_patches(pilot, fine, options, pilot.levels.at(0).has_masks() ? 8 : 2);
+  const bool masked = pilot.levels.at(0).has_masks();
+  const std::vector<std::vector<double>> quarters = pilot_on_patches(pilot, fine, options, masked ? 8 : 2);
   ReferenceIrradiance out = ref;
   const std::size_t W = std::size_t(2 * R), Wf = 2 * W;
   for (std::size_t s = 0; s < out.sphere.size(); ++s) {
     SphereReference& sr = out.sphere[s];
     const SphereReference& fr = fine.sphere[s];
     const std::vector<double>& pq = quarters[s];
-    std::vector<double> delta(sr.irradiance.size());
+    std::vector<double> delta(sr.irradiance.size()), pilot_mean(sr.irradiance.size());
     double q = 0, q0 = 0, shift = 0, mean = 0, excess_sq = 0;
     for (std::size_t y = 0; y < std::size_t(R); ++y)
       for (std::size_t x = 0; x < W; ++x) {
@@ -1610,6 +1693,7 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
         q0 += q0i;
         excess_sq += (qi - q0i) * (qi - q0i);
         delta[p] = centre[s][p] - pbar;
+        pilot_mean[p] = pbar;
         shift += delta[p] * delta[p];
         mean += sr.irradiance[p];
       }
@@ -1623,8 +1707,8 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
     sr.pilot_shape_error = mean > 0 ? std::sqrt(std::max(0.0, q - q0 + 2 * se) / (4 * n)) / mean : 0.0;
     sr.centred = 2 * sr.pilot_shape_error < sr.centring_shift;
     if (!sr.centred) continue;
-    for (std::size_t p = 0; p < sr.irradiance.size(); ++p)
-      sr.irradiance[p] = std::max(0.0, sr.irradiance[p] + delta[p]);
+    for (std::size_t p = 0; p < sr.irradiance.size(); ++p) detail::centre_patch(sr, p, centre[s][p], pilot_mean[p], masked);
+    if (masked) detail::refresh_noise_floors(sr);
   }
   return out;
 }
@@ -1666,9 +1750,10 @@ AplErrorReport evaluate_held_out_fitted(RaySource& rays, Build&& build, const Ap
     AplSet pilot;
     {
       const AplSet from_fit = build(static_cast<RaySource&>(fit));
-      pilot = centring_pilot(from_fit);
+      // A masked pilot takes the graded set's beam borders too (pilot_with_known_borders).
+      pilot = pilot_with_known_borders(centring_pilot(from_fit), set);
       if (centring_applies(options))
-        grading_pilot = centring_pilot(from_fit, centring_pilot_sigma(options.patch_resolution));
+        grading_pilot = pilot_with_known_borders(centring_pilot(from_fit, centring_pilot_sigma(options.patch_resolution)), set);
     }
     const ReferenceIrradiance fit_ref = centred_reference(gather_reference(fit, set.bounds, quiet), pilot, quiet);
     c = fit_map_resolutions(set, fit_ref, quiet, min_resolution, train_rays);
