@@ -39,6 +39,7 @@ lumx::BundleBuildOptions bundle_options(const BuildArgs& a) {
   bo.min_resolution = std::min(bo.min_resolution, a.max_resolution);
   bo.max_resolution = a.max_resolution;
   bo.place_at_convergence = a.converge;
+  bo.point_sources.enabled = a.point_sources;
   using LC = lumx::AplBuildOptions::LineClustering;
   bo.line_clustering = a.cluster_by == "start" ? LC::start_points : a.cluster_by == "line" ? LC::lines : LC::automatic;
   bo.apl_exponent = a.apl_exponent;

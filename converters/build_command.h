@@ -26,6 +26,7 @@ struct BuildArgs {
   bool progress = false;             ///< --progress: show the bar even when stderr is not a terminal
   bool converge = true;              ///< --converge / --no-converge: rays as lines (AplBuildOptions)
   std::string cluster_by = "auto";   ///< --cluster-by auto|start|line: step 1b's choice
+  bool point_sources = true;         ///< --point-sources / --no-point-sources: step 7 (AplBuildOptions)
   double apl_exponent = 0;           ///< --resolution-exponent
   double smooth_rays = 0;            ///< --smooth: AplBuildOptions::map_smoothing_rays
   unsigned threads = 0;              ///< --threads (0: every core); the bundle does not depend on it

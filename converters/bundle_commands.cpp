@@ -32,14 +32,9 @@ namespace {
 
 /// Bytes the level's maps take in memory at full resolution (float texels).
 std::uint64_t level_memory_bytes(const lumx::BundleLevelInfo& l, lumx::ChannelLayout c) {
-  const std::uint64_t masked = std::uint64_t(std::count_if(l.mask.begin(), l.mask.end(), [](int i) { return i >= 0; }));
+  const std::uint64_t masked = std::uint64_t(l.masked_apl_count());
   return (std::uint64_t(l.apl_count()) * lumx::channel_count(c) + masked) * 2 * std::uint64_t(l.map_resolution) *
          l.map_resolution * sizeof(float);
-}
-
-/// APLs of the level with a beam mask (each also holds its coverage in memory: one float a texel).
-std::size_t masked_apls(const lumx::BundleLevelInfo& l) {
-  return std::size_t(std::count_if(l.mask.begin(), l.mask.end(), [](int i) { return i >= 0; }));
 }
 
 double level_flux(const lumx::BundleLevelInfo& l, lumx::ChannelLayout c) {
@@ -85,7 +80,7 @@ int run_bundle_info(const InfoArgs& a) {
                           {"bytes_in_memory", level_memory_bytes(l, m.channels)},
                           {std::string("flux_") + flux_unit, level_flux(l, m.channels)},
                           {"has_error_table", !l.error.empty()},
-                          {"masked_apls", masked_apls(l)}});
+                          {"masked_apls", l.masked_apl_count()}});
       }
       json j = {{"bundle", a.file},
                 {"format_version", m.format_version},
@@ -146,7 +141,7 @@ int run_bundle_info(const InfoArgs& a) {
       std::size_t caps = 0;
       for (const auto& mask : m.masks) caps += mask->caps().size();
       std::printf("beam masks:  %zu (point sources behind apertures, %zu caps); masked APLs per level:", m.masks.size(), caps);
-      for (const auto& l : m.levels) std::printf(" %zu", masked_apls(l));
+      for (const auto& l : m.levels) std::printf(" %zu", l.masked_apl_count());
       std::printf("\n");
     }
     if (m.volume)

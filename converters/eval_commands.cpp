@@ -272,6 +272,13 @@ std::string table_text(const lumx::AplErrorReport& r, const std::string& bundle,
       s += buf;
       for (const auto& sr : ref.sphere) s += format_cell(100.0 * sr.noise_floor, fmt, 8);
       s += "\n";
+      // Beam masks' borders the rays cannot place (lumx::border_allowance): in the '<' bounds, not in ε̂.
+      if (std::any_of(ref.sphere.begin(), ref.sphere.end(), [](const auto& sr) { return !sr.border.empty(); })) {
+        std::snprintf(buf, sizeof buf, "%-11s %6s %5s %3s", "border", "", "", "");
+        s += buf;
+        for (const auto& sr : ref.sphere) s += format_cell(100.0 * sr.border_share, fmt, 8);
+        s += "\n";
+      }
     }
   }
   // Rays that did not start inside a sphere.
@@ -283,6 +290,9 @@ std::string table_text(const lumx::AplErrorReport& r, const std::string& bundle,
       s += "\n";
       s += buf;
     }
+  if (std::any_of(ref.sphere.begin(), ref.sphere.end(), [](const auto& sr) { return !sr.border.empty(); }))
+    s += "note: border: what a patch centre outside every beam mask may still receive, the rays being too few to "
+         "place the border there (% of the mean, as an RMS); it widens the '<' bounds, not the estimates\n";
   if (ref.zero_flux_rays > 0) {
     std::snprintf(buf, sizeof buf, "note: %llu rays carry no flux\n", static_cast<unsigned long long>(ref.zero_flux_rays));
     s += buf;
@@ -328,6 +338,7 @@ json report_json(const lumx::AplErrorReport& r, const EvalArgs& a, lumx::Photome
                        {"reference", sr.centred ? "patch centres" : "patch means"},
                        {"centring_shift", std::isfinite(sr.centring_shift) ? json(sr.centring_shift) : json()},
                        {"pilot_shape_error", std::isfinite(sr.pilot_shape_error) ? json(sr.pilot_shape_error) : json()},
+                       {"border_allowance", sr.border.empty() ? json() : json(sr.border_share)},
                        {"rays", sr.rays},
                        {"started_outside", sr.started_outside},
                        {"missed", sr.missed}});

@@ -161,6 +161,10 @@ const Command kCommands[] = {
                   "treat rays as lines: cluster them by where they come from and place each APL where its rays' "
                   "lines converge (least squares), when inside the luminaire (default); --no-converge: cluster "
                   "start points and place APLs at their box centres (the dissertation's rule)");
+       c.add_flag("--point-sources,!--no-point-sources", g_build.point_sources,
+                  "with --converge: where every ray's line passes through one of a few points, one masked APL per "
+                  "point source, its beam borders as geometry (default); --no-point-sources: keep the clustered "
+                  "set (docs/apl_sets.md, \"Point sources behind apertures\")");
        c.add_option("--cluster-by", g_build.cluster_by,
                     "with --converge: cluster rays by start point or by where their lines pass (default auto: "
                     "by line when the lines meet; see docs/apl_sets.md)")

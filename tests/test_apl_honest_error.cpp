@@ -229,6 +229,8 @@ TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
   std::printf("\n  reference (shift / the pilot's shape error, upper bound, %% of the mean):");
   for (const auto& s : r.reference.sphere)
     std::printf(" %s %.1f/%.1f", s.centred ? "centre" : "mean", 100 * s.centring_shift, 100 * s.pilot_shape_error);
+  std::printf("\n  border allowance, %% of the mean:");
+  for (const auto& s : r.reference.sphere) std::printf(" %.1f", 100 * s.border_share);
   std::printf("\n");
   // What the shape check decides, where it matters: the spots' lobes, a few patches wide, are centred
   // from d = 1 on (their 512-APL levels, 2–7 % off at points, are 13–75 % off the exact patch means
@@ -1275,17 +1277,20 @@ TEST(SpotStudy, DISABLED_WideTwoScaleForSparseMaps) {
 }
 }  // namespace
 
-// The held-out estimate of the box's masked level over 20 rays (docs/apl_sets.md, "What the table
-// stores"): per seed, the level evaluate_held_out_fitted grades (built from the even rays, point sources
-// as masked APLs) against the exact irradiance at the patch centres, beside the estimate with the noise
-// removed ('<': unresolved) and its upper bound, %. Counted: spheres where the upper bound is below 3/4 of
-// the truth (the estimate flatters), and spheres resolved more than 25 % from it. Printed, and checked
-// against the documented counts. Off by default (about 80 s):
-//   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*HeldOutEstimateOfTheMaskedLevel*'
-TEST(PinholeBoxStudy, DISABLED_HeldOutEstimateOfTheMaskedLevel) {
+namespace {
+/// The held-out estimate of the box's masked level on the rays of each seed: per seed, the level
+/// evaluate_held_out_fitted grades (built from the even rays, point sources as masked APLs) against the
+/// exact irradiance at the patch centres, beside the estimate with the noise removed ('<': unresolved)
+/// and its upper bound, %, and the border allowance of each sphere (SphereReference::border_share).
+/// Counted: spheres whose truth is above 10 % (a patch centre in a sliver one mask misses), where the
+/// upper bound is below 3/4 of the truth (the estimate flatters), and resolved more than 25 % from it.
+struct MaskedEstimateCounts {
+  int spheres = 0, spikes = 0, flatters = 0, resolved_off = 0;
+};
+MaskedEstimateCounts masked_level_estimates(const std::vector<std::uint64_t>& seeds) {
   const PinholeBox box = pinhole_box();
-  int flatters = 0, resolved_off = 0, spikes = 0, spheres = 0;
-  for (std::uint64_t seed = 11; seed < 31; ++seed) {
+  MaskedEstimateCounts n;
+  for (std::uint64_t seed : seeds) {
     auto rays = box.source(kSuiteRays, seed);
     AplBuildOptions bo;
     bo.threads = 2;
@@ -1294,7 +1299,7 @@ TEST(PinholeBoxStudy, DISABLED_HeldOutEstimateOfTheMaskedLevel) {
         *rays, [&](RaySource& train) { return build_apl_set(train, half_rays_build_options(bo, rays->info().ray_count)); },
         AplErrorOptions{}, &choice);
     const LevelErrors& row = r.levels.back();
-    ASSERT_TRUE(row.masked) << seed;
+    EXPECT_TRUE(row.masked) << seed;
     const ExactOnSpheres exact = exact_on_spheres(box, r.reference.spheres, 1);
     const std::vector<double> truth = true_errors(exact.at_centre, row);
     std::printf("seed %2d, R %d:", int(seed), row.map_resolution);
@@ -1302,16 +1307,42 @@ TEST(PinholeBoxStudy, DISABLED_HeldOutEstimateOfTheMaskedLevel) {
       const IrradianceErrors& e = row.errors[s];
       std::printf(" %4.1f/%4.1f%s/%4.1f", 100 * truth[s], 100 * e.relative_rmse_noise_removed, e.resolved ? " " : "<",
                   100 * e.noise_removed_upper);
-      ++spheres;
-      spikes += truth[s] > 0.1;
-      flatters += e.noise_removed_upper < 0.75 * truth[s];
-      resolved_off += e.resolved && std::abs(e.relative_rmse_noise_removed - truth[s]) > 0.25 * truth[s];
+      ++n.spheres;
+      n.spikes += truth[s] > 0.1;
+      n.flatters += e.noise_removed_upper < 0.75 * truth[s];
+      n.resolved_off += e.resolved && std::abs(e.relative_rmse_noise_removed - truth[s]) > 0.25 * truth[s];
     }
+    std::printf("\n    border allowance, %% of the mean:");
+    for (const SphereReference& sr : r.reference.sphere) std::printf(" %.1f", 100 * sr.border_share);
     std::printf("\n");
   }
   std::printf("%d spheres, %d with the truth above 10 %%: the upper bound below 3/4 of the truth at %d, resolved and "
-              "more than 25 %% off at %d\n", spheres, spikes, flatters, resolved_off);
-  EXPECT_EQ(spikes, 12);
-  EXPECT_EQ(flatters, 6);
-  EXPECT_EQ(resolved_off, 3);
+              "more than 25 %% off at %d\n", n.spheres, n.spikes, n.flatters, n.resolved_off);
+  return n;
+}
+}  // namespace
+
+// The box's masked level on the rays of five seeds, four of them (16, 18, 19, 23) with a patch centre in
+// a sliver of the graded level's beams that no mask holds (its truth 17-19 %): the upper bound holds
+// each truth but for the ±25 % of HonestErrorSuite only with the border allowance (without it, an upper
+// bound of 8.8-12.0 % at five of those spheres). About 20 s.
+TEST(PinholeBoxStudy, TheUpperBoundHoldsABorderNoMaskResolves) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release build only (as the held-out suite)";
+#endif
+  const MaskedEstimateCounts n = masked_level_estimates({15, 16, 18, 19, 23});
+  EXPECT_EQ(n.spikes, 5);
+  EXPECT_EQ(n.flatters, 0);
+}
+
+// The same over 20 seeds (docs/apl_sets.md, "What the table stores"), checked against the documented
+// counts. Off by default (about 80 s):
+//   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*HeldOutEstimateOfTheMaskedLevel*'
+TEST(PinholeBoxStudy, DISABLED_HeldOutEstimateOfTheMaskedLevel) {
+  std::vector<std::uint64_t> seeds;
+  for (std::uint64_t s = 11; s < 31; ++s) seeds.push_back(s);
+  const MaskedEstimateCounts n = masked_level_estimates(seeds);
+  EXPECT_EQ(n.spikes, 12);
+  EXPECT_EQ(n.flatters, 0);
+  EXPECT_EQ(n.resolved_off, 3);
 }

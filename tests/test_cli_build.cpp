@@ -165,5 +165,20 @@ TEST(CliBuild, PointSourcesBehindAperturesShipAsMaskedApls) {
   EXPECT_EQ(check.status, 0) << check.out;
   const lumx_test::CliRun info = lumx_test::run_cli("info " + lumx_test::quoted(dir / "b"));
   EXPECT_TRUE(has(info.out, "beam masks:  2 (point sources behind apertures, 8 caps); masked APLs per level: 0 2")) << info.out;
+  // Graded against the rays, the borders no mask places widen the bounds, in a row of their own.
+  const lumx_test::CliRun eval =
+      lumx_test::run_cli("eval " + lumx_test::quoted(dir / "b") + " --rays " + lumx_test::quoted(dir / "box.tm25ray"));
+  ASSERT_EQ(eval.status, 0) << eval.out;
+  EXPECT_TRUE(has(eval.out, "\nborder ")) << eval.out;
+  EXPECT_TRUE(has(eval.out, "note: border: what a patch centre outside every beam mask may still receive")) << eval.out;
+  // --no-point-sources keeps the clustered levels asked for, without masks.
+  const lumx_test::CliRun plain = lumx_test::run_cli("build " + lumx_test::quoted(dir / "box.tm25ray") + " " +
+                                                     lumx_test::quoted(dir / "p") + " --levels 1 8 --no-eval --no-point-sources");
+  ASSERT_EQ(plain.status, 0) << plain.out;
+  EXPECT_FALSE(has(plain.out, "point sources:")) << plain.out;
+  const BundleReader clustered((dir / "p").string());
+  EXPECT_EQ(clustered.manifest().format_version, 2);
+  EXPECT_EQ(clustered.manifest().levels.size(), 2u);
+  EXPECT_TRUE(clustered.manifest().masks.empty());
   fs::remove_all(dir);
 }

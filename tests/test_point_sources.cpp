@@ -480,3 +480,23 @@ TEST(MaskedReference, AMaskedPilotScalesAPatchAndItsNoise) {
   EXPECT_DOUBLE_EQ(plain.irradiance[3], 0.0);  // 1 + 0 − 1.5, floored
   EXPECT_DOUBLE_EQ(plain.variance[3], 0.5);
 }
+
+TEST(MaskedReference, AHullGainsTheSolidAngleOfItsFan) {
+  // detail::cap_gain: the solid angle hull(H ∪ w) adds to a cap's hull H, exactly (spherical triangles),
+  // however far w lies: the difference of the two hulls' solid angles (DirectionMask::solid_angle).
+  DirectionMask::Cap c;  // a square of half-width 0.2 in the chart about +z
+  c.hull = {{-0.2, -0.2}, {0.2, -0.2}, {0.2, 0.2}, {-0.2, 0.2}};
+  const double square = DirectionMask::from_caps({c}).solid_angle();
+  DirectionMaskOptions wide;
+  wide.max_half_angle = 1.49;  // w up to 84° from the axis
+  for (double qx : {0.2001, 0.21, 0.5, 3.0, 10.0}) {
+    const glm::dvec3 w = glm::normalize(glm::dvec3(qx, 0.05, 1.0));
+    DirectionMask::Cap grown = c;  // the hull with the chart point (qx, 0.05): a pentagon
+    grown.hull = {{-0.2, -0.2}, {0.2, -0.2}, {qx, 0.05}, {0.2, 0.2}, {-0.2, 0.2}};
+    const double expected = DirectionMask::from_caps({grown}, wide).solid_angle() - square;
+    EXPECT_NEAR(detail::cap_gain(c, w), expected, 1e-9 + 1e-6 * expected) << qx;
+  }
+  // Inside: no edge faces w. Behind the chart: infinite.
+  EXPECT_EQ(detail::cap_gain(c, glm::normalize(glm::dvec3(0.1, 0.1, 1.0))), 0.0);
+  EXPECT_TRUE(std::isinf(detail::cap_gain(c, glm::dvec3(0, 0, -1))));
+}

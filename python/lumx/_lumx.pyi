@@ -364,6 +364,8 @@ class BuildResult:
     @property
     def clustered_by_line(self) -> bool: ...
     @property
+    def point_sources(self) -> int: ...
+    @property
     def error_tables(self) -> bool: ...
     @property
     def far_field_flux_lm(self) -> float: ...
@@ -374,7 +376,7 @@ def build(rays: RaysArgument, out: str, *, levels: Sequence[int] = (1, 8, 64, 25
           map_resolution: int = 0, rays_per_texel: float = 8.0, patches: int = 16, evaluate: bool = True,
           c_step_deg: float = 2.5, gamma_step_deg: float = 1.0, efficacy_lm_per_w: float = 0.0,
           converge: bool = True, cluster_by: Literal["auto", "start", "line"] = "auto",
-          resolution_exponent: float = 0.0, smooth: float = 0.0, threads: int = 0,
+          resolution_exponent: float = 0.0, smooth: float = 0.0, point_sources: bool = True, threads: int = 0,
           progress: Optional[Callable[[float, str], object]] = None) -> BuildResult:
     """Rays in, a bundle out, as `lumx build` makes it; the GIL is released while it works."""
 

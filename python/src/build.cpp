@@ -18,6 +18,7 @@ struct BuildResult {
   std::vector<int> map_resolutions, built_resolutions;
   std::uint64_t rays = 0, seeds = 0, bytes = 0;
   bool clustered_by_line = false;
+  std::size_t point_sources = 0;
   bool error_tables = false;
   double far_field_flux_lm = NAN;
   double seconds = 0;
@@ -37,6 +38,8 @@ void bind_build(py::module_& m) {
       .def_readonly("bytes", &BuildResult::bytes, "bytes of the bundle (manifest and payloads)")
       .def_readonly("clustered_by_line", &BuildResult::clustered_by_line,
                     "rays were clustered by their lines' points nearest the convergence point")
+      .def_readonly("point_sources", &BuildResult::point_sources,
+                    "point sources found behind apertures (one masked APL each; 0: the clustered set stands)")
       .def_readonly("error_tables", &BuildResult::error_tables, "held-out error tables are stored in the bundle")
       .def_readonly("far_field_flux_lm", &BuildResult::far_field_flux_lm,
                     "flux of the attached far field, lm (NaN when none was attached)")
@@ -48,7 +51,7 @@ void bind_build(py::module_& m) {
       [](const py::object& rays, const std::string& out, const std::vector<std::size_t>& levels, std::size_t seeds,
          int map_resolution, double rays_per_texel, int patches, bool evaluate, double c_step_deg,
          double gamma_step_deg, double efficacy_lm_per_w, bool converge, const std::string& cluster_by,
-         double resolution_exponent, double smooth, unsigned threads, const py::object& progress) {
+         double resolution_exponent, double smooth, bool point_sources, unsigned threads, const py::object& progress) {
         using LC = lumx::AplBuildOptions::LineClustering;
         if (cluster_by != "auto" && cluster_by != "start" && cluster_by != "line")
           throw py::value_error("cluster_by: 'auto', 'start' or 'line'");
@@ -64,6 +67,7 @@ void bind_build(py::module_& m) {
         o.apl.map_resolution = map_resolution;
         o.apl.rays_per_texel = rays_per_texel;
         o.apl.place_at_convergence = converge;
+        o.apl.point_sources.enabled = point_sources;
         o.apl.line_clustering = cluster_by == "start"  ? LC::start_points
                                 : cluster_by == "line" ? LC::lines
                                                        : LC::automatic;
@@ -104,6 +108,7 @@ void bind_build(py::module_& m) {
         b.seeds = r.build.seeds;
         b.bytes = r.bytes;
         b.clustered_by_line = r.build.slid_to_convergence;
+        b.point_sources = r.build.point_sources;
         b.error_tables = r.error_tables_stored;
         if (r.far_field_attached) b.far_field_flux_lm = r.far_field_lm;
         b.seconds = r.seconds_build + r.seconds_evaluation + r.seconds_far_field + r.seconds_write;
@@ -113,13 +118,15 @@ void bind_build(py::module_& m) {
       py::arg("seeds") = 250000, py::arg("map_resolution") = 0, py::arg("rays_per_texel") = 8.0,
       py::arg("patches") = 16, py::arg("evaluate") = true, py::arg("c_step_deg") = 2.5, py::arg("gamma_step_deg") = 1.0,
       py::arg("efficacy_lm_per_w") = 0.0, py::arg("converge") = true, py::arg("cluster_by") = "auto",
-      py::arg("resolution_exponent") = 0.0, py::arg("smooth") = 0.0, py::arg("threads") = 0,
+      py::arg("resolution_exponent") = 0.0, py::arg("smooth") = 0.0, py::arg("point_sources") = true,
+      py::arg("threads") = 0,
       py::arg("progress") = py::none(),
       "Builds a bundle from rays as `lumx build RAYS OUT` does (lumx::build_bundle; same options, same "
       "defaults, same bundle): APL levels by clustering, map resolutions and error tables from held-out rays "
       "(evaluate=False skips them), level 0's far field (c_step_deg, gamma_step_deg, degrees) attached as IES "
       "and EULUMDAT. `rays`: a path, a lumx.RayFile, a structured array or mapping of arrays (position m, "
       "direction, flux lm or W), or a callable returning an iterable of chunks (read several times). "
+      "point_sources=False keeps the clustered set where every line passes through a few points (`--no-point-sources`). "
       "threads=0: every core; the bundle does not depend on it. `progress(fraction, phase)` is called from "
       "time to time, the fraction never decreasing; an exception in it (or Ctrl-C) stops the build and "
       "leaves `out` untouched. What the build leaves out (no far field for radiometric rays without an "

@@ -109,3 +109,30 @@ def test_what_the_build_leaves_out_is_a_warning(tmp_path):
     # 300 lm/W times the rays' 2 W; the far field tabulates level 0's map on a 2.5 x 1 degree grid, whose
     # bilinear table integrates a smooth distribution to well within 0.1 % (measured: 5e-5).
     assert r.far_field_flux_lm == pytest.approx(300 * 20000 * float(np.float32(1e-4)), rel=1e-3)
+
+
+def pinhole_rays(n, seed=2, flux=1e-3):
+    """A point source at (0.01, 0, 0) behind a square hole 2 cm wide in the plane z = 0.05 m: rays start in
+    the hole, every line through the source."""
+    rng = np.random.default_rng(seed)
+    source = np.array([0.01, 0.0, 0.0])
+    hole = np.stack([rng.uniform(-0.01, 0.01, n), rng.uniform(-0.01, 0.01, n), np.full(n, 0.05)], axis=1)
+    d = hole - source
+    chunk = np.zeros(n, dtype=lumx.ray_dtype())
+    chunk["position"] = hole
+    chunk["direction"] = d / np.linalg.norm(d, axis=1, keepdims=True)
+    chunk["flux"] = flux
+    return chunk
+
+
+def test_point_sources_can_be_kept_or_left_clustered(tmp_path):
+    """point_sources=True (the default, as `lumx build`): lines through one point give one masked APL;
+    False (`--no-point-sources`): the clustered levels asked for."""
+    rays = pinhole_rays(20000)
+    masked = lumx.build(rays, str(tmp_path / "m.lumx"), levels=[1, 8], evaluate=False)
+    assert masked.point_sources == 1 and masked.apl_counts == [1]
+    plain = lumx.build(rays, str(tmp_path / "p.lumx"), levels=[1, 8], evaluate=False, point_sources=False)
+    assert plain.point_sources == 0 and plain.apl_counts == [1, 8]
+    m = json.loads((tmp_path / "m.lumx" / "manifest.json").read_text())
+    assert len(m["masks"]) == 1
+    assert "masks" not in json.loads((tmp_path / "p.lumx" / "manifest.json").read_text())

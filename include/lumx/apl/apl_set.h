@@ -145,6 +145,10 @@ struct AplLevel {
       if (a.mask) return true;
     return false;
   }
+  /// APLs of the level with a mask (one per point source in a point-source set's finest level).
+  std::size_t masked_apl_count() const {
+    return std::size_t(std::count_if(apls.begin(), apls.end(), [](const Apl& a) { return bool(a.mask); }));
+  }
 };
 
 /// Recomputes a masked APL's coverage at its map's resolution in `frame` (clears it without a mask):

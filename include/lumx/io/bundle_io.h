@@ -28,6 +28,7 @@
 #include <lumx/core/diagnostic.h>
 #include <lumx/math/spherical_harmonics.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -75,6 +76,10 @@ struct BundleLevelInfo {
   std::vector<BundlePayload> maps;     ///< decreasing resolution; maps[0] is full resolution
   ErrorTable error;
   std::size_t apl_count() const { return position.size(); }
+  /// APLs with a beam mask (each also holds its coverage in memory when loaded: one float a texel).
+  std::size_t masked_apl_count() const {
+    return std::size_t(std::count_if(mask.begin(), mask.end(), [](int i) { return i >= 0; }));
+  }
 };
 
 struct BundleVolumeInfo {

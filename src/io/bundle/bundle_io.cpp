@@ -473,7 +473,7 @@ AplSet BundleReader::load(const std::vector<std::size_t>& levels, int max_resolu
   for (std::size_t k : chosen) {
     if (k >= manifest_.levels.size()) break;  // load_level reports it
     const BundleLevelInfo& l = manifest_.levels[k];
-    const std::uint64_t masked = std::uint64_t(std::count_if(l.mask.begin(), l.mask.end(), [](int i) { return i >= 0; }));
+    const std::uint64_t masked = std::uint64_t(l.masked_apl_count());
     // Each map's texels, and a masked APL's coverage (one channel) beside its map.
     decoded += (std::uint64_t(l.apl_count()) * std::uint64_t(channel_count(manifest_.channels)) + masked) * 2 *
                std::uint64_t(l.map_resolution) * std::uint64_t(l.map_resolution) * sizeof(float);
