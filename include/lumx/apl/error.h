@@ -157,7 +157,7 @@ inline IrradianceErrors compare_irradiance(const std::vector<double>& reference,
 
 /// compare_irradiance, plus the noise-removed relative RMSE from the reference's variance per patch.
 /// `border` (optional, per patch, (lx)²: SphereReference::border) widens the upper bound by its mean over
-/// m²: √(max(0, ε² − σ²) + 2u + b).
+/// m², b: √(max(0, ε² − σ²) + 2u + b); the estimate is resolved only when ε² − σ² > 2u + b.
 inline IrradianceErrors compare_irradiance(const std::vector<double>& reference, const std::vector<double>& model,
                                            const std::vector<double>& variance,
                                            const std::vector<double>* border = nullptr) {
@@ -185,9 +185,11 @@ inline IrradianceErrors compare_irradiance(const std::vector<double>& reference,
   const double excess = (sq - var) / double(n) / m2;  // ε² − σ²
   const double u = std::sqrt(u2) / double(n) / m2;
   e.relative_rmse_noise_removed = std::sqrt(std::max(0.0, excess));
-  e.noise_removed_upper = std::sqrt(std::max(0.0, excess) + 2 * u + b / double(n) / m2);
+  const double allowance = b / double(n) / m2;
+  e.noise_removed_upper = std::sqrt(std::max(0.0, excess) + 2 * u + allowance);
   e.noise_removed_standard_error = u;
-  e.resolved = excess > 2 * u;
+  // Resolved: out of the reference's noise and of what its borders may hide.
+  e.resolved = excess > 2 * u + allowance;
   return e;
 }
 
@@ -379,7 +381,8 @@ struct SphereReference {
   /// within each patch (centred_reference), where a level evaluated at one point per patch is queried.
   bool centred = false;
   /// (lx)² per patch: what the centre may receive beyond every beam mask the rays gave, as an expected
-  /// square (border_allowance); empty: none. Added to the noise-removed upper bound, never to ε̂.
+  /// square (border_allowance); empty: none. Added to the noise-removed upper bound and to what an
+  /// estimate must exceed to be resolved, never to ε̂.
   std::vector<double> border;
   double border_share = 0;  ///< √(mean border) / mean E_ref: the same as a relative RMSE
 };
@@ -850,7 +853,8 @@ struct AplErrorReport {
 inline AplSet centring_pilot(const AplSet& set, double sigma = 0);
 inline AplSet pilot_with_known_borders(AplSet pilot, const AplSet& lit);
 struct MaskEvidence;
-inline void border_allowance(ReferenceIrradiance& ref, const AplSet& pilot, const std::vector<MaskEvidence>& evidence);
+inline void border_allowance(ReferenceIrradiance& ref, const AplSet& pilot, const std::vector<MaskEvidence>& evidence,
+                             unsigned threads = 1);
 inline std::vector<MaskEvidence> mask_evidence(const AplSet& own, std::uint64_t own_rays, const AplSet* lit,
                                                std::uint64_t lit_rays);
 /// Whether the held-out evaluators centre the reference (checked_centred_reference) for these options:
@@ -882,7 +886,7 @@ inline AplErrorReport evaluate_apl_errors(const AplSet& set, RaySource& rays, co
     fine.patch_resolution = 2 * options.patch_resolution;
     fine.progress = nullptr;
     report.reference = checked_centred_reference(report.reference, gather_reference(rays, set.bounds, fine), *pilot, options);
-    if (!evidence.empty()) border_allowance(report.reference, *pilot, evidence);
+    if (!evidence.empty()) border_allowance(report.reference, *pilot, evidence, options.threads);
   }
   const std::size_t rows = set.levels.size() + (options.far_field ? 1 : 0);
   for (std::size_t k = 0; k < set.levels.size(); ++k) {
@@ -1533,6 +1537,14 @@ inline const AplLevel* most_masked_level(const AplSet& set) {
   return best;
 }
 
+namespace detail {
+/// Two masked APLs stand for one point source when they lie within 1/1000 of the bounding radius of each
+/// other (PointSourceOptions::tolerance): pilot_with_known_borders and border_allowance match by it.
+inline bool same_source(const Apl& a, const Apl& b, double bounding_radius) {
+  return double(glm::length(a.position - b.position)) <= 1e-3 * bounding_radius;
+}
+}  // namespace detail
+
 /// A masked pilot (centring_pilot) whose every mask also takes the caps of the same source's mask in
 /// `lit`, a set built from other rays of the same luminaire (the graded set, in the held-out
 /// evaluators): each masked APL of the pilot's level joins the caps of the masked APL of `lit` nearest it,
@@ -1552,14 +1564,13 @@ inline AplSet pilot_with_known_borders(AplSet pilot, const AplSet& lit) {
   if (pilot.levels.empty() || !pilot.levels[0].has_masks()) return pilot;
   const AplLevel* known = most_masked_level(lit);
   if (!known) return pilot;
-  const double same = 1e-3 * std::max(pilot.bounds.radius, lit.bounds.radius);
   AplLevel& level = pilot.levels[0];
   for (Apl& a : level.apls) {
     if (!a.mask) continue;
     const Apl* match = nullptr;
     for (const Apl& b : known->apls)
       if (b.mask && (!match || glm::length(b.position - a.position) < glm::length(match->position - a.position))) match = &b;
-    if (!match || !(double(glm::length(match->position - a.position)) <= same) || match->mask == a.mask) continue;
+    if (!match || !detail::same_source(a, *match, pilot.bounds.radius) || match->mask == a.mask) continue;
     std::vector<DirectionMask::Cap> caps = a.mask->caps();
     caps.insert(caps.end(), match->mask->caps().begin(), match->mask->caps().end());
     a.mask = std::make_shared<const DirectionMask>(DirectionMask::from_caps(std::move(caps)));
@@ -1576,23 +1587,39 @@ struct MaskEvidence {
 };
 
 namespace detail {
-/// The solid angle (sr) the hull of cap c would gain with direction w: the fan of triangles from w's
+/// A cap of a beam mask with its hull's vertices as unit directions (read once per cap).
+struct CapVertices {
+  const DirectionMask::Cap* cap = nullptr;
+  std::vector<glm::dvec3> vertex;
+};
+inline std::vector<CapVertices> cap_vertices(const DirectionMask& mask) {
+  std::vector<CapVertices> out;
+  for (const DirectionMask::Cap& c : mask.caps()) {
+    CapVertices v;
+    v.cap = &c;
+    for (const glm::dvec2& q : c.hull) v.vertex.push_back(glm::normalize(c.axis + q.x * c.e1 + q.y * c.e2));
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+/// The solid angle (sr) the hull of a cap would gain with direction w: the fan of triangles from w's
 /// chart point q to the edges q sees. The gnomonic chart maps great circles to lines, so each is the
 /// spherical triangle (w, a, b) of the vertices' directions, whose solid angle is exact (Van Oosterom and
 /// Strackee 1983: tan(Ω/2) = |a·(b × c)| / (1 + a·b + b·c + c·a)). Infinite when w is not in the cap's
 /// chart half-sphere.
-inline double cap_gain(const DirectionMask::Cap& c, const glm::dvec3& w) {
+inline double cap_gain(const CapVertices& cv, const glm::dvec3& w) {
+  const DirectionMask::Cap& c = *cv.cap;
   const double z = glm::dot(w, c.axis);
   if (!(z > 0)) return INFINITY;
   const glm::dvec2 q(glm::dot(w, c.e1) / z, glm::dot(w, c.e2) / z);
-  auto direction = [&](const glm::dvec2& v) { return glm::normalize(c.axis + v.x * c.e1 + v.y * c.e2); };
   double omega = 0;
   const std::size_t n = c.hull.size();
   for (std::size_t k = 0; k < n; ++k) {
     const glm::dvec2 a = c.hull[k], b = c.hull[(k + 1) % n];
     const double cross = (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x);
     if (cross >= 0) continue;  // the edge does not face q
-    const glm::dvec3 A = direction(a), B = direction(b);
+    const glm::dvec3 &A = cv.vertex[k], &B = cv.vertex[(k + 1) % n];
     omega += 2 * std::atan2(std::abs(glm::dot(w, glm::cross(A, B))), 1 + glm::dot(w, A) + glm::dot(A, B) + glm::dot(B, w));
   }
   return omega;
@@ -1604,20 +1631,19 @@ inline bool cap_near(const DirectionMask::Cap& c, const glm::dvec3& w, double ma
   return glm::dot(w, c.axis) >= std::cos(std::min(c.reach + margin, 0.5 * kPi));
 }
 
-/// The unit direction of the vertex nearest w of `mask`'s hulls within `margin` of w (cap_near); w itself
-/// when none is.
-inline glm::dvec3 nearest_hull_vertex(const DirectionMask& mask, const glm::dvec3& w, double margin) {
+/// The hull vertex nearest w among the caps within `margin` of it (cap_near); w itself when none is.
+inline glm::dvec3 nearest_hull_vertex(const std::vector<CapVertices>& caps, const glm::dvec3& w, double margin) {
   glm::dvec3 best = w;
   double best_cos = -2;
-  for (const DirectionMask::Cap& c : mask.caps())
-    if (cap_near(c, w, margin))
-      for (const glm::dvec2& v : c.hull) {
-      const glm::dvec3 d = glm::normalize(c.axis + v.x * c.e1 + v.y * c.e2);
-      const double cs = glm::dot(d, w);
-      if (cs > best_cos) best_cos = cs, best = d;
-    }
+  for (const CapVertices& cv : caps)
+    if (cap_near(*cv.cap, w, margin))
+      for (const glm::dvec3& d : cv.vertex) {
+        const double cs = glm::dot(d, w);
+        if (cs > best_cos) best_cos = cs, best = d;
+      }
   return best;
 }
+
 }  // namespace detail
 
 /// What a patch centre outside every mask may still receive from a masked APL, the border allowance of
@@ -1630,14 +1656,18 @@ inline glm::dvec3 nearest_hull_vertex(const DirectionMask& mask, const glm::dvec
 /// where the border lies beyond the hull), a centre whose model and pilot are both dark there may be off by
 /// L = I(w)·cos/r² with probability p: the allowance is Σ p·L² over the pilot's masked APLs (the nearest
 /// cap of each hull). It is the expected square of what
-/// no mask can tell; it widens the upper bound only (compare_irradiance): which patch centre of a sphere
+/// no mask can tell; it widens the upper bound and what counts as resolved (compare_irradiance), never
+/// ε̂: which patch centre of a sphere
 /// falls in a sliver is a matter of chance, and ε̂ stays the estimate of the centres as they are. Over
 /// 20 rayings of the box with holes, 6 spheres had a centre the graded level wrongly calls dark and no
 /// mask holds: their upper bounds held the truth only with the allowance (docs/apl_sets.md, "What the
 /// table stores"). `evidence` gives each hull set with its flux per ray; APLs are matched to
 /// the pilot's by position within 1/1000 of the bounding radius. I is the pilot's intensity at its hull
-/// vertex nearest w (map over coverage), for λ and L alike. Only the centred spheres get it.
-inline void border_allowance(ReferenceIrradiance& ref, const AplSet& pilot, const std::vector<MaskEvidence>& evidence) {
+/// vertex nearest w (map over coverage), for λ and L alike; λ takes the rays as of equal flux (the mean:
+/// weights that do not depend on direction; rays of no flux, which no hull holds, make it a little
+/// high). Only the centred spheres get it. Patches are spread over `threads` (AplErrorOptions::threads).
+inline void border_allowance(ReferenceIrradiance& ref, const AplSet& pilot, const std::vector<MaskEvidence>& evidence,
+                             unsigned threads) {
   // Caps further than this (rad) beyond their reach are not read: a hull would have to gain a fan at
   // least this wide, which the rays of a beam, 500 at least (PointSourceOptions::min_rays), leave empty
   // with a probability far below any that counts.
@@ -1645,64 +1675,78 @@ inline void border_allowance(ReferenceIrradiance& ref, const AplSet& pilot, cons
   if (pilot.levels.empty() || !pilot.levels[0].has_masks()) return;
   const AplLevel& level = pilot.levels[0];
   const std::vector<glm::dvec3> dirs = ref.spheres.evaluation_directions(1);
-  const double same = 1e-3 * std::max(pilot.bounds.radius, 1e-12);
-  // Per pilot APL, the matching mask of each evidence level, or null.
-  std::vector<std::vector<const DirectionMask*>> masks(level.size());
+  // Per pilot APL: its own mask's caps, and those of the matching mask of each evidence level (empty:
+  // none matches), with their vertices as directions.
+  struct Beam {
+    std::vector<detail::CapVertices> own;
+    std::vector<std::vector<detail::CapVertices>> evidence;
+    std::vector<bool> matched;
+  };
+  std::vector<Beam> beams(level.size());
   for (std::size_t i = 0; i < level.size(); ++i) {
-    if (!level.apls[i].mask) continue;
+    const Apl& a = level.apls[i];
+    if (!a.mask) continue;
+    beams[i].own = detail::cap_vertices(*a.mask);
     for (const MaskEvidence& ev : evidence) {
       const DirectionMask* found = nullptr;
       if (ev.level && ev.flux_per_ray > 0)
         for (const Apl& b : ev.level->apls)
-          if (b.mask && double(glm::length(b.position - level.apls[i].position)) <= same) found = b.mask.get();
-      masks[i].push_back(found);
+          if (b.mask && detail::same_source(a, b, pilot.bounds.radius)) found = b.mask.get();
+      beams[i].evidence.push_back(found ? detail::cap_vertices(*found) : std::vector<detail::CapVertices>{});
+      beams[i].matched.push_back(found != nullptr);
     }
   }
+  // What patch centre x, seen along the outward unit u, may still receive (lx²).
+  auto allowance_at = [&](const glm::dvec3& x, const glm::dvec3& u) {
+    double total = 0;
+    for (std::size_t i = 0; i < level.size(); ++i) {
+      const Apl& a = level.apls[i];
+      if (!a.mask) continue;
+      const glm::dvec3 d = x - glm::dvec3(a.position);
+      const double r2 = glm::dot(d, d);
+      if (!(r2 > 0)) continue;
+      const glm::dvec3 w = d / std::sqrt(r2);
+      const double cosine = glm::dot(w, u);  // the patch's normal is −u (evaluate_level)
+      if (cosine <= 0 || a.mask->contains(w)) continue;
+      // The beam's intensity just inside its border: the pilot's at the hull vertex nearest w (a map
+      // read beyond the border would give what its texels hold there, nothing or a part).
+      const glm::vec3 m = level.frame.map_direction(glm::vec3(detail::nearest_hull_vertex(beams[i].own, w, kBorderReach)));
+      const double I = luminance_of(pilot.channels, glm::dvec3(a.map.lookup(m))) /
+                       double(std::max(kMinMaskCoverage, a.coverage.lookup(m).x));
+      if (!(I > 0)) continue;
+      double expected_rays = 0;  // Σ over the hull sets of λ·Ω at their nearest cap
+      bool any = false;
+      for (std::size_t h = 0; h < evidence.size(); ++h) {
+        if (!beams[i].matched[h]) continue;
+        any = true;
+        double gain = INFINITY;
+        for (const detail::CapVertices& cv : beams[i].evidence[h])
+          if (detail::cap_near(*cv.cap, w, kBorderReach)) gain = std::min(gain, detail::cap_gain(cv, w));
+        if (gain == 0) {  // inside this hull (which the pilot's mask did not take): lit for certain
+          expected_rays = 0;
+          break;
+        }
+        expected_rays += I / evidence[h].flux_per_ray * gain;
+      }
+      if (!any) continue;
+      const double L = I * cosine / r2;
+      total += std::exp(-expected_rays) * L * L;
+    }
+    return total;
+  };
   for (std::size_t s = 0; s < ref.sphere.size(); ++s) {
     SphereReference& sr = ref.sphere[s];
     if (!sr.centred) continue;
+    const std::size_t np = std::min(dirs.size(), sr.irradiance.size());
     sr.border.assign(sr.irradiance.size(), 0.0);
+    // Patches are independent: each job fills its own, so any thread count gives the same values.
+    constexpr std::size_t kJobs = 64;
+    detail::parallel_jobs(kJobs, threads, [&](std::size_t job) {
+      for (std::size_t p = np * job / kJobs; p < np * (job + 1) / kJobs; ++p)
+        sr.border[p] = allowance_at(ref.spheres.centre() + ref.spheres.radius(s) * dirs[p], dirs[p]);
+    });
     double sum = 0, mean = 0;
-    for (std::size_t p = 0; p < dirs.size() && p < sr.border.size(); ++p) {
-      const glm::dvec3 x = ref.spheres.centre() + ref.spheres.radius(s) * dirs[p];
-      for (std::size_t i = 0; i < level.size(); ++i) {
-        const Apl& a = level.apls[i];
-        if (!a.mask) continue;
-        const glm::dvec3 d = x - glm::dvec3(a.position);
-        const double r2 = glm::dot(d, d);
-        if (!(r2 > 0)) continue;
-        const glm::dvec3 w = d / std::sqrt(r2);
-        const double cosine = glm::dot(w, dirs[p]);  // the patch's normal is −u (evaluate_level)
-        if (cosine <= 0 || a.mask->contains(w)) continue;
-        // The beam's intensity just inside its border: the pilot's at the hull vertex nearest w (a map
-        // read beyond the border would give what its texels hold there, nothing or a part).
-        const glm::vec3 m = level.frame.map_direction(glm::vec3(detail::nearest_hull_vertex(*a.mask, w, kBorderReach)));
-        const double I = luminance_of(pilot.channels, glm::dvec3(a.map.lookup(m))) /
-                         double(std::max(kMinMaskCoverage, a.coverage.lookup(m).x));
-        if (!(I > 0)) continue;
-        double expected_rays = 0;  // Σ over the hull sets of λ·Ω at their nearest cap
-        bool any = false;
-        for (std::size_t h = 0; h < evidence.size(); ++h) {
-          const DirectionMask* mk = masks[i][h];
-          if (!mk) continue;
-          if (mk->contains(w)) {  // inside this hull: lit for certain (the pilot's own mask missed it)
-            expected_rays = 0;
-            any = true;
-            break;
-          }
-          double gain = INFINITY;
-          for (const DirectionMask::Cap& c : mk->caps())
-            if (detail::cap_near(c, w, kBorderReach)) gain = std::min(gain, detail::cap_gain(c, w));
-          expected_rays += I / evidence[h].flux_per_ray * gain;
-          any = true;
-        }
-        if (!any) continue;
-        const double L = I * cosine / r2;
-        sr.border[p] += std::exp(-expected_rays) * L * L;
-      }
-      sum += sr.border[p];
-      mean += sr.irradiance[p];
-    }
+    for (std::size_t p = 0; p < sr.irradiance.size(); ++p) sum += sr.border[p], mean += sr.irradiance[p];
     const double n = double(sr.border.size());
     sr.border_share = mean > 0 ? std::sqrt(sum / n) / (mean / n) : 0.0;
   }
@@ -1757,6 +1801,19 @@ inline std::vector<std::vector<double>> pilot_on_patches(const AplSet& pilot, co
 }
 
 namespace detail {
+/// Points per patch side a masked pilot is read at on spheres `ms` (centred_reference, and the quarters
+/// of checked_centred_reference): `most`, fewer while the spheres' patches × k² exceed 2^22 points (a
+/// few tens of MB while a level is evaluated), at least 2. Its borders need many: the lit share of a
+/// patch to 1/k².
+inline int masked_pilot_subsamples(const MeasurementSpheres& ms, int most) {
+  const double patches = double(ms.sphere_count()) * 2.0 * double(ms.patch_resolution()) * double(ms.patch_resolution());
+  int k = most;
+  while (k > 2 && patches * double(k) * double(k) > double(1u << 22)) --k;
+  return k;
+}
+/// Beyond this ratio P(c) / P̄ a masked patch is moved by adding instead: a centre lit where the pilot
+/// lights under 1/16 of its patch (a sliver's tip) would scale the patch's noise by more than 16.
+inline constexpr double kMaxCentringScale = 16;
 /// Moves patch p of `sr` from its mean to its centre by a pilot's value there (`centre`) and its mean over
 /// the patch (`mean`). Plain pilots add the difference, E_c = max(0, E + P(c) − P̄) (centred_reference).
 /// A masked pilot's shape within a patch is a border times a smooth intensity, so it scales instead:
@@ -1765,16 +1822,25 @@ namespace detail {
 /// pilot's own intensity noise (an R 8 map from a quarter of the rays, a few % a texel) no longer
 /// enters: added, its intensity error times (1 − f) went into every border patch, and the box's masked
 /// level, 3.0 % off at points at d = 1, was estimated at 5.1 % (7.7 % but unresolved, scaled;
-/// docs/apl_sets.md, "What the table stores"). A patch the pilot leaves dark throughout keeps its mean.
+/// docs/apl_sets.md, "What the table stores"). A patch the pilot leaves dark throughout keeps its mean;
+/// one whose ratio exceeds kMaxCentringScale is moved by adding.
+/// Patch value e moved to its centre (centre_patch), without moving it.
+inline double centred_value(double e, double centre, double mean, bool masked) {
+  if (masked) {
+    if (!(mean > 0)) return e;                      // dark throughout in the pilot: the mean stays
+    if (centre / mean <= kMaxCentringScale) return e * (centre / mean);
+  }
+  return std::max(0.0, e + centre - mean);
+}
 inline void centre_patch(SphereReference& sr, std::size_t p, double centre, double mean, bool masked) {
-  if (masked && mean > 0) {
+  if (masked && mean > 0 && centre / mean <= kMaxCentringScale) {
     const double g = centre / mean;
     sr.irradiance[p] *= g;
     sr.variance[p] *= g * g;
     if (p < sr.half_even.size()) sr.half_even[p] *= g;
     if (p < sr.half_odd.size()) sr.half_odd[p] *= g;
-  } else if (!masked) {
-    sr.irradiance[p] = std::max(0.0, sr.irradiance[p] + centre - mean);
+  } else {
+    sr.irradiance[p] = centred_value(sr.irradiance[p], centre, mean, masked);
   }
 }
 
@@ -1811,9 +1877,9 @@ inline void refresh_noise_floors(SphereReference& sr) {
 /// or 16 for a masked pilot. Throws std::invalid_argument unless k is 0 or 2 ≤ k ≤ 16.
 inline ReferenceIrradiance centred_reference(const ReferenceIrradiance& ref, const AplSet& pilot,
                                              const AplErrorOptions& options, int k) {
-  // By default 4 × 4 points a patch; 16 × 16 for a masked pilot, whose patches hold sharp borders (the
-  // lit share of a patch to 1/256, as checked_centred_reference takes it).
-  if (k == 0) k = pilot.levels.at(0).has_masks() ? 16 : 4;
+  // By default 4 × 4 points a patch; for a masked pilot, whose patches hold sharp borders, as many as
+  // detail::masked_pilot_subsamples allows (16 × 16 on the fit's R 32 patches).
+  if (k == 0) k = pilot.levels.at(0).has_masks() ? detail::masked_pilot_subsamples(ref.spheres, 16) : 4;
   if (k < 2 || k > 16) throw std::invalid_argument("centred_reference: k must be 0 or in [2, 16]");
   ReferenceIrradiance out = ref;
   const std::vector<std::vector<double>> at_centre = pilot_on_patches(pilot, ref, options, 1),
@@ -1854,10 +1920,12 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
     throw std::invalid_argument("checked_centred_reference: the fine reference is not on the quarters of the patches");
   const std::vector<std::vector<double>> centre = pilot_on_patches(pilot, ref, options, 1);
   // The quarters' means at 2 × 2 points each: the same 4 × 4 points per patch as centred_reference's P̄.
-  // A masked pilot's patches hold sharp borders, whose lit share 2 × 2 points find to a quarter: 8 × 8
-  // points a quarter there (docs/apl_sets.md, "What the table stores").
+  // A masked pilot's patches hold sharp borders, whose lit share 2 × 2 points find to a quarter: up to
+  // 8 × 8 points a quarter there (detail::masked_pilot_subsamples; docs/apl_sets.md, "What the table
+  // stores").
   const bool masked = pilot.levels.at(0).has_masks();
-  const std::vector<std::vector<double>> quarters = pilot_on_patches(pilot, fine, options, masked ? 8 : 2);
+  const std::vector<std::vector<double>> quarters =
+      pilot_on_patches(pilot, fine, options, masked ? detail::masked_pilot_subsamples(fine.spheres, 8) : 2);
   ReferenceIrradiance out = ref;
   const std::size_t W = std::size_t(2 * R), Wf = 2 * W;
   for (std::size_t s = 0; s < out.sphere.size(); ++s) {
@@ -1883,7 +1951,9 @@ inline ReferenceIrradiance checked_centred_reference(const ReferenceIrradiance& 
         q += qi;
         q0 += q0i;
         excess_sq += (qi - q0i) * (qi - q0i);
-        delta[p] = centre[s][p] - pbar;
+        // The move the centring makes (by adding, or for a masked pilot by scaling: centre_patch).
+        delta[p] = masked ? detail::centred_value(sr.irradiance[p], centre[s][p], pbar, true) - sr.irradiance[p]
+                          : centre[s][p] - pbar;
         pilot_mean[p] = pbar;
         shift += delta[p] * delta[p];
         mean += sr.irradiance[p];
