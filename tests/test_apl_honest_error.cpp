@@ -1324,8 +1324,8 @@ MaskedEstimateCounts masked_level_estimates(const std::vector<std::uint64_t>& se
 
 // The box's masked level on the rays of five seeds, four of them (16, 18, 19, 23) with a patch centre in
 // a sliver of the graded level's beams that no mask holds (its truth 17-19 %): the upper bound holds
-// each truth but for the ±25 % of HonestErrorSuite only with the border allowance (without it, an upper
-// bound of 8.8-12.0 % at five of those spheres). About 20 s.
+// each truth but for the ±25 % of HonestErrorSuite only with the border allowance (in a trial without
+// it, an upper bound of 8.8-12.0 % at five of those spheres). About 20 s.
 TEST(PinholeBoxStudy, TheUpperBoundHoldsABorderNoMaskResolves) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release build only (as the held-out suite)";
