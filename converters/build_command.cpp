@@ -51,6 +51,8 @@ lumx::BundleBuildOptions bundle_options(const BuildArgs& a) {
   o.far_field.gamma_step_deg = a.gamma_step_deg;
   o.far_field.luminous_efficacy_lm_per_w = a.efficacy_lm_per_w;
   o.source_name = a.rays;
+  o.representations = a.representations;
+  o.representation_options.execution.threads = a.threads;
   return o;
 }
 
@@ -124,6 +126,8 @@ void print_build_result(const lumx::BundleBuildResult& r, const BuildArgs& a, lu
     std::cout << "\n"
               << format_error_table(r.held_out.report, a.out + " (its levels rebuilt from the even rays)",
                                     a.rays + " (odd rays the levels never saw)", r.held_out.report.reference.quantity);
+  if (!r.representation_grades.empty())
+    std::cout << "\n" << format_model_grades(r.representation_grades, "each rebuilt from the even rays, graded on the odd");
 }
 
 }  // namespace lumx_cli

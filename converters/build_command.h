@@ -30,6 +30,7 @@ struct BuildArgs {
   double apl_exponent = 0;           ///< --resolution-exponent
   double smooth_rays = 0;            ///< --smooth: AplBuildOptions::map_smoothing_rays
   unsigned threads = 0;              ///< --threads (0: every core); the bundle does not depend on it
+  std::vector<std::string> representations;  ///< --representations: registered names besides "apl"
 };
 
 int run_build(const BuildArgs& a);

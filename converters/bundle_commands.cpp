@@ -92,6 +92,10 @@ int run_bundle_info(const InfoArgs& a) {
                 {"levels", levels},
                 {"total_bytes", m.total_bytes()}};
       if (!m.masks.empty()) j["beam_masks"] = m.masks.size();
+      json reps = json::array();
+      for (const lumx::BundleRepresentation& r : reader.representations())
+        reps.push_back({{"name", r.name}, {"type", r.type}, {"description", r.description}, {"bytes_on_disk", r.bytes}});
+      j["representations"] = reps;
       if (m.volume)
         j["volume"] = {{"counts", {m.volume->counts.x, m.volume->counts.y, m.volume->counts.z}},
                        {"voxel_size_m", m.volume->voxel_size},
@@ -143,6 +147,13 @@ int run_bundle_info(const InfoArgs& a) {
       std::printf("beam masks:  %zu (point sources behind apertures, %zu caps); masked APLs per level:", m.masks.size(), caps);
       for (const auto& l : m.levels) std::printf(" %zu", l.masked_apl_count());
       std::printf("\n");
+    }
+    if (!m.models.empty()) {
+      std::printf("models:      (further representations, by registered type)\n");
+      for (const lumx::BundleRepresentation& r : reader.representations())
+        if (r.model >= 0)
+          std::printf("  %-16s %-14s %12llu bytes  %s\n", r.name.c_str(), r.type.c_str(), (unsigned long long)r.bytes,
+                      r.description.c_str());
     }
     if (m.volume)
       std::printf("volume:      %d x %d x %d voxels of %g m, %d SH bands, %d channel(s), %llu bytes\n",

@@ -483,6 +483,42 @@ void store_tables(const EvalArgs& a, const lumx::BundleReader& reader, const lum
   lumx::write_bundle(a.bundle, set, volume ? &*volume : nullptr, wo);
 }
 
+json grades_json(const std::vector<lumx::ModelGrade>& grades) {
+  json out = json::array();
+  for (const lumx::ModelGrade& g : grades) {
+    json spheres = json::array();
+    for (const lumx::ModelSphereError& s : g.spheres)
+      spheres.push_back({{"relative_distance", s.relative_distance}, {"relative_rmse", s.relative_rmse},
+                         {"noise_removed", s.noise_removed}, {"noise_removed_upper", s.noise_removed_upper},
+                         {"noise_floor", s.noise_floor}, {"resolved", s.resolved}});
+    out.push_back({{"type", g.type}, {"description", g.description}, {"bytes", g.bytes},
+                   {"ns_per_evaluation", g.ns_per_evaluation}, {"reference_rays", g.reference_rays},
+                   {"spheres", spheres}});
+  }
+  return out;
+}
+
+// The bundle's models (BundleReader::representations() past the APL levels), each graded through the seam:
+// on rays of another run as they are, or rebuilt from the even rays of the bundle's own and graded on the odd.
+std::vector<lumx::ModelGrade> grade_bundle_models(const lumx::BundleReader& reader, lumx::RaySource& rays, bool own_rays,
+                                                  const lumx::AplErrorOptions& o, const lumx::BoundingSphere& bounds) {
+  std::vector<lumx::ModelGrade> grades;
+  lumx::ModelGradeOptions go;
+  go.relative_distances = o.relative_distances;
+  go.patch_resolution = o.patch_resolution;
+  go.bounds = bounds;
+  for (std::size_t i = 0; i < reader.manifest().models.size(); ++i) {
+    if (own_rays) {
+      grades.push_back(lumx::grade_held_out(reader.manifest().models[i].type, rays, {}, go));
+    } else {
+      const std::unique_ptr<lumx::LightModel> m = reader.load_model(i);
+      grades.push_back(lumx::grade_model(*m, rays, go));
+    }
+    grades.back().description = reader.manifest().models[i].name + ": " + grades.back().description;
+  }
+  return grades;
+}
+
 int run_rays(const EvalArgs& a) {
   const bool tty = ::isatty(2) != 0;
   const lumx::BundleReader reader(a.bundle);
@@ -545,11 +581,21 @@ int run_rays(const EvalArgs& a) {
     report = lumx::evaluate_apl_errors(set, *rays, o);
     if (is_source) against += " (the rays it was built from: errors shared with them cancel)";
   }
+  const std::vector<lumx::ModelGrade> grades =
+      grade_bundle_models(reader, *rays, is_source && !a.independent, o, set.bounds);
   if (tty) std::fputs("\r              \r", stderr);
   if (a.json) {
-    std::printf("%s\n", report_json(report, a, set.quantity).dump(1).c_str());
+    json j = report_json(report, a, set.quantity);
+    if (!grades.empty()) j["models"] = grades_json(grades);
+    std::printf("%s\n", j.dump(1).c_str());
   } else {
     std::fputs(table_text(report, graded, against, set.quantity).c_str(), stdout);
+    if (!grades.empty())
+      std::fputs(("\n" + format_model_grades(grades, is_source && !a.independent
+                                                          ? "each rebuilt from the even rays, graded on the odd"
+                                                          : "as stored, against " + a.rays))
+                     .c_str(),
+                 stdout);
   }
   if (!a.plots_dir.empty()) {
     const std::vector<std::string> files = write_plots(report, a);
@@ -563,6 +609,32 @@ int run_rays(const EvalArgs& a) {
 }
 
 }  // namespace
+
+std::string format_model_grades(const std::vector<lumx::ModelGrade>& grades, const std::string& how) {
+  std::string out = "representations graded through the seam (" + how + "); noise-removed relative RMSE of "
+                    "irradiance at patch centres, its upper bound, * resolved:\n";
+  char buf[256];
+  if (grades.empty()) return out;
+  std::snprintf(buf, sizeof buf, "  %-14s", "type");
+  out += buf;
+  for (const lumx::ModelSphereError& s : grades.front().spheres) {
+    std::snprintf(buf, sizeof buf, " %16s", ("d " + format_cell(s.relative_distance, "%*g", 0)).c_str());
+    out += buf;
+  }
+  out += "        bytes  ns/point  model\n";
+  for (const lumx::ModelGrade& g : grades) {
+    std::snprintf(buf, sizeof buf, "  %-14s", g.type.c_str());
+    out += buf;
+    for (const lumx::ModelSphereError& s : g.spheres) {
+      std::snprintf(buf, sizeof buf, " %6.2f%% <%6.2f%%%s", 100 * s.noise_removed, 100 * s.noise_removed_upper,
+                    s.resolved ? "*" : " ");
+      out += buf;
+    }
+    std::snprintf(buf, sizeof buf, " %12zu %9.1f  %s\n", g.bytes, g.ns_per_evaluation, g.description.c_str());
+    out += buf;
+  }
+  return out;
+}
 
 std::string format_error_table(const lumx::AplErrorReport& r, const std::string& bundle, const std::string& rays,
                                lumx::PhotometricQuantity q) {

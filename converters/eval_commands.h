@@ -5,6 +5,7 @@
 #pragma once
 
 #include <lumx/apl/error.h>
+#include <lumx/model/grading.h>
 
 #include <string>
 #include <vector>
@@ -34,6 +35,10 @@ struct EvalArgs {
 /// The speed-against-error tables of `lumx eval --rays` (also printed by `lumx build`).
 std::string format_error_table(const lumx::AplErrorReport& r, const std::string& bundle, const std::string& rays,
                                lumx::PhotometricQuantity q);
+
+/// The table of representations graded through the seam (lumx/model/grading.h): one row a model, ε̂ (its
+/// upper bound, '*' when resolved) per distance, bytes and ns per irradiance call.
+std::string format_model_grades(const std::vector<lumx::ModelGrade>& grades, const std::string& how);
 
 /// `lumx eval`: exactly one of --points or --rays. Returns the exit status (1 on errors, located).
 int run_eval(const EvalArgs& a);

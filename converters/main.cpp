@@ -165,6 +165,11 @@ const Command kCommands[] = {
                   "with --converge: where every ray's line passes through one of a few points, one masked APL per "
                   "point source, its beam borders as geometry (default); --no-point-sources: keep the clustered "
                   "set (docs/apl_sets.md, \"Point sources behind apertures\")");
+       c.add_option("--representations", g_build.representations,
+                    "representations to store, comma-separated, by registered name (default apl; e.g. "
+                    "apl,far-field): each besides apl is built from every ray, stored as a model and graded on "
+                    "held-out rays (docs/architecture.md, \"The representation seam\")")
+           ->delimiter(',');
        c.add_option("--cluster-by", g_build.cluster_by,
                     "with --converge: cluster rays by start point or by where their lines pass (default auto: "
                     "by line when the lines meet; see docs/apl_sets.md)")

@@ -12,7 +12,7 @@
 #include <lumx/bake/gltf_reader.h>
 #include <lumx/io/atomic_file.h>
 #include <lumx/io/bundle_io.h>
-#include <lumx/io/image_io.h>
+#include <lumx/render/image_io.h>
 #include <lumx/render/apl_room_background.h>
 #include <lumx/render/appearance_study.h>
 

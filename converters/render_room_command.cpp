@@ -8,7 +8,7 @@
 
 #include <lumx/bake/tracer.h>
 #include <lumx/io/bundle_io.h>
-#include <lumx/io/image_io.h>
+#include <lumx/render/image_io.h>
 #include <lumx/io/atomic_file.h>
 #include <lumx/render/room_render.h>
 

@@ -405,7 +405,7 @@ TEST(Bundle, InconsistentOrHostileManifestsAreRejected) {
   expect([](auto& j) { j["levels"][0]["maps"][0]["file"] = "../../etc/passwd"; }, "/levels/0/maps/0/file");
   expect([](auto& j) { j["levels"][0]["maps"][0]["sha256"] = "abc"; }, "/levels/0/maps/0/sha256");
   expect([](auto& j) { j["levels"][0]["maps"][1]["resolution"] = 3; }, "/levels/0/maps/1/resolution");
-  expect([](auto& j) { j["format_version"] = 4; }, "/format_version");
+  expect([](auto& j) { j["format_version"] = lumx::bundle::kFormatVersion + 1; }, "/format_version");
   expect([](auto& j) { j["format_version"] = 0; }, "/format_version");
   expect([](auto& j) { j["units"]["intensity"] = "W/sr"; }, "/units/flux");
   expect([](auto& j) { j["channels"] = {"R", "G"}; }, "/channels");

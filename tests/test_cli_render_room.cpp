@@ -6,7 +6,7 @@
 #include "luminaire_test_scenes.h"
 #include "test_support.h"
 
-#include <lumx/io/image_io.h>
+#include <lumx/render/image_io.h>
 
 #include <nlohmann/json.hpp>
 

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// tests/test_image_io.cpp — OpenEXR image files (lumx/io/image_io.h) and the pinhole camera (lumx/render/camera.h).
+// tests/test_image_io.cpp — OpenEXR image files (lumx/render/image_io.h) and the pinhole camera (lumx/render/camera.h).
 #include <lumx/core/diagnostic.h>
-#include <lumx/io/image_io.h>
+#include <lumx/render/image_io.h>
 #include <lumx/render/camera.h>
 
 #include "test_support.h"

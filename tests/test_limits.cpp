@@ -12,7 +12,7 @@
 #include <lumx/io/tm33_io.h>
 
 #include <gtest/gtest.h>
-#include <lumx/io/image_io.h>
+#include <lumx/render/image_io.h>
 
 #include "io/bundle/exr_image.h"
 #include "rayset_test_support.h"

@@ -9,7 +9,7 @@
 
 #include <lumx/bake/fresnel.h>
 #include <lumx/bake/tracer.h>
-#include <lumx/io/image_io.h>
+#include <lumx/render/image_io.h>
 #include <lumx/render/apl_room_background.h>
 #include <lumx/render/appearance.h>
 #include <lumx/render/appearance_study.h>

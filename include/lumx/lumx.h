@@ -7,6 +7,7 @@
 #include <lumx/version.h>
 
 #include <lumx/core/diagnostic.h>
+#include <lumx/core/execution.h>
 #include <lumx/core/units.h>
 
 #include <lumx/math/aabb.h>
@@ -46,6 +47,12 @@
 #include <lumx/apl/lod.h>
 #include <lumx/apl/sampling.h>
 
+#include <lumx/model/apl_model.h>
+#include <lumx/model/far_field_model.h>
+#include <lumx/model/grading.h>
+#include <lumx/model/light_model.h>
+#include <lumx/model/registry.h>
+
 #include <lumx/volume/radiance_volume.h>
 
 #include <lumx/render/adaptive_kernel_density.h>
@@ -60,4 +67,4 @@
 #include <lumx/io/tm33_io.h>
 #include <lumx/io/gldf_io.h>
 #include <lumx/io/rayset_io.h>
-#include <lumx/io/image_io.h>
+#include <lumx/render/image_io.h>

@@ -5,6 +5,8 @@
 
 #include <lumx/core/diagnostic.h>
 
+#include "photometry/number_text.h"  // format_number, which the writers use
+
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -52,9 +54,6 @@ std::string to_utf8(std::string_view s);
 /// must be consumed; NaN and infinities are refused. Accepts ".5" and "5.".
 bool parse_number(std::string_view token, double& out);
 
-/// Shortest decimal text with at most `significant_digits` significant digits ("12.5", "1000", "0.001"),
-/// locale-independent, never "-0". Used by the writers.
-std::string format_number(double v, int significant_digits);
 
 /// At most `max_bytes` of `s`, made valid UTF-8 (for quoting file content in diagnostics, which end up
 /// in JSON).

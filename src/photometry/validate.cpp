@@ -4,7 +4,7 @@
 #include <lumx/photometry/metrics.h>
 #include <lumx/photometry/validate.h>
 
-#include "io/text_scanner.h"
+#include "photometry/number_text.h"
 
 #include <cmath>
 #include <cstdio>

@@ -84,6 +84,35 @@ double AplRoomIlluminance::at(int, const glm::dvec3& x, const glm::dvec3& n, dou
   return luminance_of(set_.channels, e.irradiance);
 }
 
+namespace {
+// The room's shadow rays, from a point of the model (its frame) to a receiver (the room's).
+class RoomVisibility final : public Visibility {
+ public:
+  RoomVisibility(const RoomScene& scene, const glm::dvec3& offset) : scene_(scene), offset_(offset) {}
+  bool visible(const glm::dvec3& from, const glm::dvec3& to) const override {
+    return scene_.visible(from + offset_, to + offset_);
+  }
+
+ private:
+  const RoomScene& scene_;
+  glm::dvec3 offset_;
+};
+}  // namespace
+
+ModelRoomIlluminance::ModelRoomIlluminance(const LightModel& model, const glm::dvec3& offset, const RoomScene& scene,
+                                           bool shadows)
+    : model_(model), offset_(offset), scene_(scene), shadows_(shadows && !scene.room().occluders.empty()) {
+  if (model.quantity() != PhotometricQuantity::photometric)
+    throw std::invalid_argument("ModelRoomIlluminance: the model is radiometric (W/sr); illuminance needs cd");
+}
+
+double ModelRoomIlluminance::at(int, const glm::dvec3& x, const glm::dvec3& n, double, double, std::uint64_t) const {
+  const glm::dvec3 local = x - offset_;  // the point in the model's frame
+  if (!shadows_) return luminance_of(model_.channels(), model_.irradiance(local, n));
+  const RoomVisibility visibility(scene_, offset_);
+  return luminance_of(model_.channels(), model_.irradiance(local, n, &visibility));
+}
+
 AplSet far_field_set_of_bundle(const BundleReader& bundle, int map_resolution) {
   const auto& attachments = bundle.manifest().attachments;
   std::size_t chosen = attachments.size();

@@ -7,7 +7,7 @@
 // leave the same state, with at most a temporary that the next write removes (tests/test_killed_writes.cpp).
 #include <lumx/apl/apl_set.h>
 #include <lumx/io/bundle_io.h>
-#include <lumx/io/image_io.h>
+#include <lumx/render/image_io.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/io/rayset_io.h>
 #include <lumx/render/image.h>

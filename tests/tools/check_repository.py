@@ -9,12 +9,16 @@
 2. Layout: include/lumx/ holds only the version header template at its top (everything else lives in a
    module folder); every compiled file under src/ is listed in src/CMakeLists.txt; docs/architecture.md
    names every public header and every module folder, so the map stays true.
-3. Third-party data: no tracked file has the same bytes as a file under SHARED_DIR/data (real-world data is
+3. Module order: docs/architecture.md states it on one line, "Module order (...): a → b → ...", and
+   every public header of include/lumx/M/ and every file of src/M/ includes (as <lumx/N/...> or "N/...")
+   only modules N that come before M or M itself, so the include graph has no cycle.
+4. Third-party data: no tracked file has the same bytes as a file under SHARED_DIR/data (real-world data is
    read there in place, never committed). Without SHARED_DIR the check is reported as skipped, except
    under CI (CI=true), which always has it.
 Prints one line per finding and exits 1 if there is any.
 """
 import hashlib
+import re
 import os
 import subprocess
 import sys
@@ -95,7 +99,33 @@ def main():
             if name not in architecture:
                 findings.append(f'docs/architecture.md: layout: public header {f} is not named')
 
-    # 3. Third-party data.
+    # 3. Module order.
+    order_line = re.search(r'^Module order[^:]*:(.*)$', architecture, re.MULTILINE)
+    if not order_line:
+        findings.append('docs/architecture.md: module order: no line "Module order (...): a \u2192 b \u2192 ..."')
+    else:
+        order = [m.strip(' `.') for m in order_line.group(1).split('\u2192')]
+        rank = {m: i for i, m in enumerate(order)}
+        for m in modules:
+            if m not in rank:
+                findings.append(f'docs/architecture.md: module order: module {m} is not in the stated order')
+        for f in files:
+            parts = f.split('/')
+            if f.startswith('include/lumx/') and len(parts) >= 4 and f.endswith('.h'):
+                m = parts[2]
+            elif f.startswith('src/') and len(parts) >= 3 and f.endswith(('.h', '.cpp')):
+                m = parts[1]
+            else:
+                continue
+            if m not in rank:
+                continue
+            with open(os.path.join(root, f), encoding='utf-8', errors='replace') as fh:
+                for n, line in enumerate(fh, 1):
+                    for d in re.findall(r'^\s*#\s*include\s*[<"](?:lumx/)?([a-z_]+)/', line):
+                        if d in rank and rank[d] > rank[m]:
+                            findings.append(f'{f}:{n}: module order: {m} includes {d}, which comes after it')
+
+    # 4. Third-party data.
     data = os.path.join(shared, 'data') if shared else ''
     if data and os.path.isdir(data):
         theirs = {}

@@ -8,6 +8,8 @@
 // `lumx build` and `lumx bake` are this call plus printing; an embedder gets the same bundle from it.
 #pragma once
 
+#include <lumx/model/grading.h>
+#include <lumx/model/registry.h>
 #include <lumx/apl/builder.h>
 #include <lumx/apl/error.h>
 #include <lumx/io/bundle_io.h>
@@ -43,6 +45,11 @@ struct BundleBuildOptions {
   /// A grading already made by evaluate_bundle_levels on these same rays with these same options (e.g.
   /// the last pass of a bake): reused instead of graded again.
   const HeldOutEvaluation* evaluated = nullptr;
+  /// Further registered representations (model/registry.h; "apl" is the levels above and is skipped):
+  /// each built from all the rays with `representation_options` and stored as a model named by its type;
+  /// with `evaluate`, each is also built from the even rays and graded on the odd ones (grade_held_out).
+  std::vector<std::string> representations;
+  ModelBuildOptions representation_options;
   /// Fraction done (0..1) and phase, for the whole call.
   std::function<void(double, const char*)> progress;
 };
@@ -63,6 +70,7 @@ struct BundleBuildResult {
   std::uint64_t bytes = 0;                ///< the bundle's payload bytes (manifest total)
   double seconds_build = 0, seconds_evaluation = 0, seconds_far_field = 0, seconds_write = 0;
   std::vector<std::string> notes;         ///< what was left out and why (no far field, no error tables)
+  std::vector<ModelGrade> representation_grades;  ///< per further representation graded, in order
 };
 
 /// The held-out grading build_bundle stores as error tables: a set built with `o.apl` from the even rays

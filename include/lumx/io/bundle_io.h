@@ -10,6 +10,8 @@
 //   ...                            box-filtered to R/2, R/4, ... (flux-exact, see SphereMap::downsampled)
 //   volume.exr                     the radiance volume's SH coefficients (float), if any
 //   attachments/NAME               files shipped with the set, e.g. its far field as IES and EULUMDAT
+//   models/NAME/PAYLOAD            the payloads of further representations (model/registry.h): each a
+//                                  manifest section written by its type's codec, and named payloads
 // Every payload's size and SHA-256 are in the manifest; maps are half floats unless a value exceeds half's
 // range (65504) or the peak is so small that half would lose precision, in which case that payload is
 // float — never a silent Inf (hard-cases §3).
@@ -27,6 +29,8 @@
 #include <lumx/apl/apl_set.h>
 #include <lumx/core/diagnostic.h>
 #include <lumx/math/spherical_harmonics.h>
+#include <lumx/model/light_model.h>
+#include <lumx/model/registry.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -40,11 +44,12 @@ LUMX_NAMESPACE_BEGIN
 class RadianceVolume;
 
 namespace bundle {
-inline constexpr int kFormatVersion = 3;
+inline constexpr int kFormatVersion = 4;
 /// The oldest format version this lumx reads. Version 2 added a level's optional "map_frame"; a version 1
 /// bundle's maps are in the photometric frame. Version 3 added the optional "masks" (beam masks of point
 /// sources behind apertures) and a level's "mask"; a set without masks is still written as version 2, so
-/// that earlier readers read it.
+/// that earlier readers read it. Version 4 added "models" (representations by registered type); a bundle
+/// without them is written as version 2 or 3 as before.
 inline constexpr int kOldestFormatVersion = 1;
 inline constexpr const char* kFormatName = "lumx-bundle";
 inline constexpr const char* kManifestName = "manifest.json";
@@ -82,6 +87,20 @@ struct BundleLevelInfo {
   }
 };
 
+/// A representation stored by its registered type's codec (model/registry.h).
+struct BundleModelInfo {
+  std::string name;     ///< unique in the bundle: 1–128 of [A-Za-z0-9._-]
+  std::string type;     ///< the registered type name
+  std::string section;  ///< the codec's section, as the text of one JSON object
+  /// Payload name → file (models/NAME/PAYLOAD), size and checksum; in the order the codec added them.
+  std::vector<std::pair<std::string, BundlePayload>> payloads;
+  std::uint64_t payload_bytes() const {
+    std::uint64_t b = 0;
+    for (const auto& [n, p] : payloads) b += p.bytes;
+    return b;
+  }
+};
+
 struct BundleVolumeInfo {
   glm::dvec3 lo{0.0}, hi{0.0};  ///< grid bounds, m
   glm::ivec3 counts{0};         ///< voxels per axis
@@ -106,6 +125,7 @@ struct BundleManifest {
   std::vector<std::shared_ptr<const DirectionMask>> masks;
   std::optional<BundleVolumeInfo> volume;
   std::vector<std::pair<BundleAttachment, BundlePayload>> attachments;  ///< name/type and file/bytes/sha256
+  std::vector<BundleModelInfo> models;  ///< further representations, by registered type
   std::uint64_t manifest_bytes = 0;
 
   /// Bytes of every payload plus the manifest: what a full load reads.
@@ -123,6 +143,19 @@ struct BundleWriteOptions {
   int min_stored_resolution = 8;
   /// Files to ship in attachments/ (names must be unique).
   std::vector<BundleAttachment> attachments;
+  /// Further representations, each written by the codec of its type() (which must be registered and
+  /// write sections); names unique, 1–128 of [A-Za-z0-9._-].
+  std::vector<std::pair<std::string, std::shared_ptr<const LightModel>>> models;
+};
+
+/// One representation a bundle holds, as BundleReader::representations() lists them.
+struct BundleRepresentation {
+  std::string name;         ///< "apl:K" for APL level K; a model's own name
+  std::string type;         ///< registered type name
+  std::string description;  ///< from the manifest alone (no payload read)
+  std::uint64_t bytes = 0;  ///< bytes on disk a full load reads
+  int level = -1;           ///< the APL level, or −1
+  int model = -1;           ///< index in BundleManifest::models, or −1
 };
 
 /// Writes `set` (and `volume`, if given) as a bundle folder at `path`, replacing an existing bundle
@@ -137,6 +170,8 @@ struct BundleLimits {
   std::size_t max_levels = 64;
   std::size_t max_apls_per_level = 1u << 20;
   std::size_t max_masks = 4096;             ///< beam masks in a manifest
+  std::size_t max_models = 64;              ///< entries of "models"
+  std::size_t max_model_payloads = 1024;    ///< payloads of one model
   std::size_t max_caps_per_mask = kMaxMaskCaps;            ///< caps in one mask (256)
   std::size_t max_hull_vertices = kMaxMaskHullVertices;    ///< vertices of one cap's hull (4 096)
   /// The reader computes each masked APL's coverage (mask_coverage_subsamples(R)² sub-directions a texel, each tested against
@@ -149,6 +184,8 @@ struct BundleLimits {
   /// Largest total decoded size of one BundleReader::load() at full resolution.
   std::uint64_t max_loaded_bytes = 8ull << 30;
 };
+
+std::vector<Diagnostic> check_bundle(const std::string& path, double flux_tolerance);
 
 /// Opens a bundle and reads its manifest only; levels and the volume are loaded on request.
 class BundleReader {
@@ -179,10 +216,20 @@ class BundleReader {
   /// The contents of attachment `index` (checksum verified).
   std::string read_attachment(std::size_t index) const;
 
+  /// Model `index` of the manifest's "models", read by its type's codec, which reads only the payloads it
+  /// needs (checksum verified). Throws lumx::Error naming /models/INDEX when its type is not registered
+  /// in this process or its section or payloads are malformed.
+  std::unique_ptr<LightModel> load_model(std::size_t index, const ModelLoadOptions& options = {}) const;
+  /// Every representation the bundle holds, whatever its type: each APL level ("apl"), then the models.
+  std::vector<BundleRepresentation> representations() const;
+  /// Representation `index` of representations(); an APL level is loaded at options.max_resolution.
+  std::unique_ptr<LightModel> load_representation(std::size_t index, const ModelLoadOptions& options = {}) const;
+
   /// Bytes read from disk through this reader so far (manifest included).
   std::uint64_t bytes_read() const { return bytes_read_; }
 
  private:
+  friend std::vector<Diagnostic> check_bundle(const std::string& path, double flux_tolerance);
   std::string read_payload(const BundlePayload& p, const std::string& field) const;
 
   std::string path_;

@@ -21,6 +21,7 @@
 #include <lumx/apl/apl_set.h>
 #include <lumx/bake/luminaire.h>
 #include <lumx/bake/tracer.h>
+#include <lumx/model/light_model.h>
 #include <lumx/render/adaptive_kernel_density.h>
 #include <lumx/render/room_scene.h>
 
@@ -65,6 +66,22 @@ class AplRoomIlluminance : public RoomIlluminance {
   std::uint64_t seed_;
   bool shadows_;
   bool any_occluder_;
+};
+
+/// Direct illuminance from any representation (model/light_model.h) placed at `offset`: its
+/// irradiance(), with the room's shadow rays as its Visibility when `shadows`.
+class ModelRoomIlluminance : public RoomIlluminance {
+ public:
+  /// Throws std::invalid_argument for a radiometric model (illuminance needs cd).
+  ModelRoomIlluminance(const LightModel& model, const glm::dvec3& offset, const RoomScene& scene, bool shadows = true);
+  double at(int surface, const glm::dvec3& x, const glm::dvec3& n, double u, double v,
+            std::uint64_t key) const override;
+
+ private:
+  const LightModel& model_;
+  glm::dvec3 offset_;
+  const RoomScene& scene_;
+  bool shadows_;
 };
 
 /// The one-APL far-field set of a bundle: its IES attachment (far_field.ies, or any *.ies) through

@@ -140,6 +140,16 @@ HeldOutEvaluation evaluate_bundle_levels(RaySource& rays, const BundleBuildOptio
 }
 
 BundleBuildResult build_bundle(RaySource& rays, const std::string& out, const BundleBuildOptions& o) {
+  // Unknown or unbuildable representations are refused before any work.
+  for (std::size_t i = 0; i < o.representations.size(); ++i) {
+    const std::string& type = o.representations[i];
+    const ModelType* t = find_model_type(type);
+    if (!t) throw_at_field(out, "representations", "no representation is registered as \"" + type + "\"");
+    if (type != "apl" && (!t->build || !t->write))
+      throw_at_field(out, "representations", "\"" + type + "\" cannot be built from rays and stored as a model");
+    for (std::size_t j = 0; j < i; ++j)
+      if (o.representations[j] == type) throw_at_field(out, "representations", "\"" + type + "\" is given twice");
+  }
   const auto start = Clock::now();
   const RaysetInfo& info = rays.info();
   BundleBuildResult result;
@@ -218,6 +228,21 @@ BundleBuildResult build_bundle(RaySource& rays, const std::string& out, const Bu
   }
   const auto far_done = Clock::now();
   for (const auto& attachment : o.attachments) wo.attachments.push_back(attachment);
+  for (const std::string& type : o.representations) {
+    if (type == "apl") continue;  // the levels above
+    if (o.progress) o.progress(0.9, type.c_str());
+    ModelBuildOptions mo = o.representation_options;
+    if (mo.execution.threads == 0) mo.execution.threads = o.apl.threads;
+    wo.models.emplace_back(type, std::shared_ptr<const LightModel>(build_model(type, rays, mo)));
+    if (o.evaluate) {
+      ModelGradeOptions go;
+      go.relative_distances = o.errors.relative_distances;
+      go.patch_resolution = o.errors.patch_resolution;
+      go.bounds = set.bounds;
+      go.execution.threads = mo.execution.threads;
+      result.representation_grades.push_back(grade_held_out(type, rays, mo, go));
+    }
+  }
   if (o.progress) o.progress(0.95, "writing");
   write_bundle(out, set, o.volume, wo);
   result.bytes = BundleReader(out).manifest().total_bytes();

@@ -4,6 +4,7 @@
 #include <lumx/io/bundle_io.h>
 
 #include <lumx/io/atomic_file.h>
+#include <lumx/model/apl_model.h>
 #include <lumx/volume/radiance_volume.h>
 #include <lumx/version.h>
 
@@ -25,6 +26,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 
 LUMX_NAMESPACE_BEGIN
 
@@ -137,13 +139,22 @@ void require_replaceable_bundle(const fs::path& target, const std::string& path)
     const std::string name = e.path().filename().string();
     const bool expected = (name == bundle::kManifestName && e.is_regular_file()) ||
                           (name == "volume.exr" && e.is_regular_file()) ||
-                          ((name == "levels" || name == "attachments") && e.is_directory());
+                          ((name == "levels" || name == "attachments" || name == "models") && e.is_directory());
     if (!expected) fail(path, "path", refuse + " (it holds \"" + name + "\")");
   }
   if (fs::is_directory(target / "attachments"))
     for (const auto& e : fs::directory_iterator(target / "attachments"))
       if (!e.is_regular_file() || !detail::is_attachment_name(e.path().filename().string()))
         fail(path, "path", refuse + " (attachments/ holds \"" + e.path().filename().string() + "\")");
+  if (fs::is_directory(target / "models"))
+    for (const auto& m : fs::directory_iterator(target / "models")) {
+      if (!m.is_directory() || !detail::is_attachment_name(m.path().filename().string()))
+        fail(path, "path", refuse + " (models/ holds \"" + m.path().filename().string() + "\")");
+      for (const auto& e : fs::directory_iterator(m.path()))
+        if (!e.is_regular_file() || !detail::is_attachment_name(e.path().filename().string()))
+          fail(path, "path", refuse + " (models/" + m.path().filename().string() + "/ holds \"" +
+                                 e.path().filename().string() + "\")");
+    }
   if (fs::is_directory(target / "levels"))
     for (const auto& e : fs::directory_iterator(target / "levels"))
       if (!e.is_regular_file() || e.path().extension() != ".exr")
@@ -168,6 +179,34 @@ void swap_in(const std::string& fresh, const fs::path& target, const std::string
   if (::rename(aside.c_str(), fresh.c_str()) != 0) fs::remove_all(aside);
 }
 
+// The payloads a codec adds while its model is written: models/NAME/PAYLOAD in the temporary folder.
+class ModelSink final : public ModelPayloadSink {
+ public:
+  ModelSink(const std::string& tmp, const std::string& model, const std::string& bundle, BundleModelInfo& info)
+      : tmp_(tmp), model_(model), bundle_(bundle), info_(info) {}
+  void add(const std::string& name, const std::string& bytes) override {
+    const std::string field = "models/" + model_ + "/" + name;
+    if (!detail::is_attachment_name(name)) fail(bundle_, field, "a payload name must be 1-128 of [A-Za-z0-9._-]");
+    for (const auto& [other, p] : info_.payloads)
+      if (other == name) fail(bundle_, field, "payload \"" + name + "\" is added twice");
+    if (info_.payloads.size() >= BundleLimits{}.max_model_payloads) fail(bundle_, field, "more payloads than BundleLimits::max_model_payloads");
+    if (bytes.size() > BundleLimits{}.max_payload_bytes) fail(bundle_, field, "larger than BundleLimits::max_payload_bytes");
+    BundlePayload p;
+    p.file = field;
+    p.bytes = bytes.size();
+    p.sha256 = detail::sha256_hex(bytes);
+    fs::create_directories(fs::path(tmp_) / "models" / model_);
+    write_scratch_file(tmp_, p.file, bytes, bundle_);
+    info_.payloads.emplace_back(name, std::move(p));
+  }
+
+ private:
+  const std::string& tmp_;
+  std::string model_;
+  const std::string& bundle_;
+  BundleModelInfo& info_;
+};
+
 }  // namespace
 
 std::uint64_t BundleManifest::total_bytes() const {
@@ -176,6 +215,7 @@ std::uint64_t BundleManifest::total_bytes() const {
     for (const BundlePayload& p : l.maps) total += p.bytes;
   if (volume) total += volume->payload.bytes;
   for (const auto& a : attachments) total += a.second.bytes;
+  for (const BundleModelInfo& m : models) total += m.payload_bytes();
   return total;
 }
 
@@ -276,12 +316,36 @@ void write_bundle(const std::string& path, const AplSet& set, const RadianceVolu
       write_scratch_file(tmp, p.file, a.bytes, path);
       m.attachments.emplace_back(BundleAttachment{a.name, a.media_type, {}}, p);
     }
+    for (std::size_t i = 0; i < options.models.size(); ++i) {
+      const auto& [name, model] = options.models[i];
+      const std::string at = "models/" + std::to_string(i);
+      if (!model) fail(path, at, "no model given");
+      if (!detail::is_attachment_name(name)) fail(path, at + "/name", "\"" + name + "\" is not 1-128 of [A-Za-z0-9._-]");
+      for (const BundleModelInfo& other : m.models)
+        if (other.name == name) fail(path, at + "/name", "\"" + name + "\" is given twice");
+      const std::string type = model->type();
+      const ModelType* t = find_model_type(type);
+      if (!t) fail(path, at + "/type", "no representation is registered as \"" + type + "\"");
+      if (!t->write) fail(path, at + "/type", "\"" + type + "\" is stored by the bundle itself, not as a model");
+      BundleModelInfo info;
+      info.name = name;
+      info.type = type;
+      ModelSink sink(tmp, name, path, info);
+      info.section = t->write(*model, sink);
+      if (!detail::is_json_object_text(info.section))
+        fail(path, at + "/section", "the codec of \"" + type + "\" wrote no JSON object");
+      m.models.push_back(std::move(info));
+    }
     // The writer's output must be what its reader accepts: parse it back before anything is replaced.
-    m.format_version = m.masks.empty() ? 2 : 3;  // earlier readers read a set without masks (bundle_io.h)
+    // Earlier readers read a set without masks (version 2) and one without models (version 3).
+    m.format_version = !m.models.empty() ? 4 : m.masks.empty() ? 2 : 3;
     const std::string manifest_text = detail::manifest_to_json(m);
     detail::parse_manifest(manifest_text, path + "/" + bundle::kManifestName, BundleLimits{});
     write_scratch_file(tmp, bundle::kManifestName, manifest_text, path);
     sync_folder(tmp + "/levels", path, false);
+    for (const BundleModelInfo& info : m.models)
+      if (!info.payloads.empty()) sync_folder(tmp + "/models/" + info.name, path, false);
+    if (!m.models.empty()) sync_folder(tmp + "/models", path, false);
     sync_folder(tmp, path, false);
 
     if (exists) {
@@ -508,6 +572,105 @@ std::string BundleReader::read_attachment(std::size_t index) const {
   return read_payload(manifest_.attachments[index].second, "/attachments/" + std::to_string(index));
 }
 
+namespace {
+
+// A model's payloads as its codec reads them: only those it asks for, each size- and checksum-verified.
+class ModelSource final : public ModelPayloadSource {
+ public:
+  ModelSource(const BundleModelInfo& info, std::string where, std::function<std::string(const BundlePayload&, const std::string&)> read)
+      : info_(info), where_(std::move(where)), read_(std::move(read)) {}
+  std::vector<std::string> names() const override {
+    std::vector<std::string> n;
+    for (const auto& [name, p] : info_.payloads) n.push_back(name);
+    return n;
+  }
+  std::uint64_t size(const std::string& name) const override { return find(name).bytes; }
+  std::string read(const std::string& name) const override { return read_(find(name), field_of(name)); }
+  const std::string& where() const override { return where_; }
+
+ private:
+  std::string field_of(const std::string& name) const {
+    for (std::size_t q = 0; q < info_.payloads.size(); ++q)
+      if (info_.payloads[q].first == name) return "/models/" + model_index() + "/payloads/" + std::to_string(q);
+    return "/models/" + model_index() + "/payloads";
+  }
+  std::string model_index() const { return where_.substr(where_.rfind('/') + 1); }
+  const BundlePayload& find(const std::string& name) const {
+    for (const auto& [n, p] : info_.payloads)
+      if (n == name) return p;
+    throw_at_field(where_, "payloads", "model \"" + info_.name + "\" has no payload \"" + name + "\"");
+  }
+  const BundleModelInfo& info_;
+  std::string where_;
+  std::function<std::string(const BundlePayload&, const std::string&)> read_;
+};
+
+}  // namespace
+
+std::unique_ptr<LightModel> BundleReader::load_model(std::size_t index, const ModelLoadOptions& options) const {
+  const std::string manifest = join(path_, bundle::kManifestName);
+  if (index >= manifest_.models.size()) fail(manifest, "/models", std::to_string(index) + " does not exist");
+  const BundleModelInfo& info = manifest_.models[index];
+  const std::string at = "/models/" + std::to_string(index);
+  const ModelType* t = find_model_type(info.type);
+  if (!t || !t->read)
+    fail(manifest, at + "/type", "no representation is registered as \"" + info.type + "\" in this program");
+  // where(): the manifest and the model's pointer, e.g. bundle/manifest.json#/models/0.
+  const ModelSource source(info, manifest + "#" + at,
+                           [this](const BundlePayload& p, const std::string& field) { return read_payload(p, field); });
+  std::unique_ptr<LightModel> model;
+  try {
+    model = t->read(info.section, source, options);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(manifest, at, "\"" + info.type + "\" could not read it: " + e.what());
+  }
+  if (!model) fail(manifest, at, "\"" + info.type + "\" read no model");
+  if (model->type() != info.type) fail(manifest, at + "/type", "the codec of \"" + info.type + "\" made a \"" + model->type() + "\"");
+  return model;
+}
+
+std::vector<BundleRepresentation> BundleReader::representations() const {
+  std::vector<BundleRepresentation> out;
+  for (std::size_t k = 0; k < manifest_.levels.size(); ++k) {
+    const BundleLevelInfo& l = manifest_.levels[k];
+    BundleRepresentation r;
+    r.name = "apl:" + std::to_string(k);
+    r.type = "apl";
+    r.description = std::to_string(l.apl_count()) + (l.apl_count() == 1 ? " APL" : " APLs") + ", maps R " +
+                    std::to_string(l.map_resolution);
+    if (const std::size_t masked = l.masked_apl_count(); masked > 0) r.description += ", " + std::to_string(masked) + " masked";
+    r.bytes = l.maps.empty() ? 0 : l.maps.front().bytes;
+    r.level = int(k);
+    out.push_back(std::move(r));
+  }
+  for (std::size_t i = 0; i < manifest_.models.size(); ++i) {
+    const BundleModelInfo& m = manifest_.models[i];
+    BundleRepresentation r;
+    r.name = m.name;
+    r.type = m.type;
+    const ModelType* t = find_model_type(m.type);
+    r.description = t ? t->description : "(type not registered in this program)";
+    r.bytes = m.payload_bytes();
+    r.model = int(i);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::unique_ptr<LightModel> BundleReader::load_representation(std::size_t index, const ModelLoadOptions& options) const {
+  const std::vector<BundleRepresentation> all = representations();
+  if (index >= all.size())
+    fail(join(path_, bundle::kManifestName), "representation", std::to_string(index) + " does not exist (" +
+                                                                   std::to_string(all.size()) + " listed)");
+  const BundleRepresentation& r = all[index];
+  if (r.model >= 0) return load_model(std::size_t(r.model), options);
+  auto set = std::make_shared<AplSet>(empty_set());
+  set->levels.push_back(load_level(std::size_t(r.level), options.max_resolution));
+  return std::make_unique<AplLevelModel>(std::move(set), 0);
+}
+
 RadianceVolume BundleReader::load_volume() const {
   if (!manifest_.volume) fail(path_, "/volume", "the bundle has no radiance volume");
   const BundleVolumeInfo& v = *manifest_.volume;
@@ -578,6 +741,18 @@ std::vector<Diagnostic> check_bundle(const std::string& path, double flux_tolera
       reader->read_attachment(i);
     } catch (const Error& e) {
       out.push_back(e.diagnostic());
+    }
+  }
+  // Every model through its codec (which reads and verifies its payloads), then any payload it left unread.
+  for (std::size_t i = 0; i < m.models.size(); ++i) {
+    try {
+      reader->load_model(i);
+      for (std::size_t q = 0; q < m.models[i].payloads.size(); ++q)
+        reader->read_payload(m.models[i].payloads[q].second, "/models/" + std::to_string(i) + "/payloads/" + std::to_string(q));
+    } catch (const Error& e) {
+      out.push_back(e.diagnostic());
+    } catch (const std::exception& e) {
+      note(join(path, bundle::kManifestName), "/models/" + std::to_string(i), e.what());
     }
   }
   if (!all_levels) return out;

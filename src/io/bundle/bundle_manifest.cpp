@@ -18,6 +18,12 @@ namespace detail {
 
 using nlohmann::json;
 
+bool is_json_object_text(const std::string& text) {
+  if (detail::json_too_deep_at(text) != std::string_view::npos) return false;
+  const json j = json::parse(text, nullptr, false);
+  return !j.is_discarded() && j.is_object();
+}
+
 bool is_attachment_name(const std::string& name) {
   if (name.empty() || name.size() > 128 || name == "." || name == "..") return false;
   for (char c : name)
@@ -207,6 +213,16 @@ std::string manifest_to_json(const BundleManifest& m) {
       j["attachments"].push_back(
           {{"file", p.file}, {"bytes", p.bytes}, {"sha256", p.sha256}, {"media_type", a.media_type}});
   }
+  if (!m.models.empty()) {
+    j["models"] = json::array();
+    for (const BundleModelInfo& model : m.models) {
+      json payloads = json::array();
+      for (const auto& [name, p] : model.payloads)
+        payloads.push_back({{"name", name}, {"file", p.file}, {"bytes", p.bytes}, {"sha256", p.sha256}});
+      j["models"].push_back({{"name", model.name}, {"type", model.type}, {"section", json::parse(model.section)},
+                             {"payloads", payloads}});
+    }
+  }
   if (m.volume) {
     const BundleVolumeInfo& v = *m.volume;
     json vol = payload_json(v.payload, false);
@@ -257,7 +273,7 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
     r.fail(members.repeated(), "this name appears twice in its object; readers disagree on which value counts");
   if (!j.is_object()) r.fail("", "the manifest is not a JSON object");
   r.only(j, "", {"format", "format_version", "generator", "units", "channels", "bounding_sphere", "provenance",
-                 "levels", "masks", "volume", "attachments"});
+                 "levels", "masks", "volume", "attachments", "models"});
   BundleManifest m;
   m.manifest_bytes = text.size();
   if (r.string(r.member(j, "", "format"), "/format") != bundle::kFormatName)
@@ -471,6 +487,50 @@ BundleManifest parse_manifest(std::string_view text, const std::string& file, co
         r.fail(at + "/sha256", "not 64 lowercase hexadecimal digits");
       a.media_type = r.string(r.member(list[i], at, "media_type"), at + "/media_type");
       m.attachments.emplace_back(std::move(a), std::move(p));
+    }
+  }
+  if (const json* mj = r.optional_member(j, "models")) {
+    if (m.format_version < 4) r.fail("/models", "needs format_version 4");
+    const json& list = r.array(*mj, "/models", std::size_t(-1));
+    if (list.size() > limits.max_models)
+      r.fail("/models", "more than BundleLimits::max_models (" + std::to_string(limits.max_models) + ") models");
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string at = "/models/" + std::to_string(i);
+      r.only(list[i], at, {"name", "type", "section", "payloads"});
+      BundleModelInfo model;
+      model.name = r.string(r.member(list[i], at, "name"), at + "/name");
+      if (!is_attachment_name(model.name)) r.fail(at + "/name", "must be 1-128 of [A-Za-z0-9._-]");
+      if (!names.insert(model.name).second) r.fail(at + "/name", "\"" + model.name + "\" is given twice");
+      model.type = r.string(r.member(list[i], at, "type"), at + "/type");
+      if (model.type.empty() || model.type.size() > 64 ||
+          model.type.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-") != std::string::npos)
+        r.fail(at + "/type", "must be 1-64 of [a-z0-9-]");
+      const json& section = r.member(list[i], at, "section");
+      if (!section.is_object()) r.fail(at + "/section", "expected an object");
+      model.section = section.dump();
+      const json& payloads = r.array(r.member(list[i], at, "payloads"), at + "/payloads", std::size_t(-1));
+      if (payloads.size() > limits.max_model_payloads)
+        r.fail(at + "/payloads", "more than BundleLimits::max_model_payloads (" + std::to_string(limits.max_model_payloads) + ")");
+      std::set<std::string> payload_names;
+      for (std::size_t q = 0; q < payloads.size(); ++q) {
+        const std::string pp = at + "/payloads/" + std::to_string(q);
+        r.only(payloads[q], pp, {"name", "file", "bytes", "sha256"});
+        const std::string name = r.string(r.member(payloads[q], pp, "name"), pp + "/name");
+        if (!is_attachment_name(name)) r.fail(pp + "/name", "must be 1-128 of [A-Za-z0-9._-]");
+        if (!payload_names.insert(name).second) r.fail(pp + "/name", "\"" + name + "\" is given twice");
+        BundlePayload p;
+        p.file = r.string(r.member(payloads[q], pp, "file"), pp + "/file");
+        if (p.file != "models/" + model.name + "/" + name) r.fail(pp + "/file", "must be models/" + model.name + "/" + name);
+        if (!files.insert(p.file).second) r.fail(pp + "/file", "\"" + p.file + "\" is listed twice");
+        p.bytes = std::uint64_t(r.integer(r.member(payloads[q], pp, "bytes"), pp + "/bytes", 0,
+                                          (long long)limits.max_payload_bytes, "BundleLimits::max_payload_bytes"));
+        p.sha256 = r.string(r.member(payloads[q], pp, "sha256"), pp + "/sha256");
+        if (p.sha256.size() != 64 || p.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
+          r.fail(pp + "/sha256", "not 64 lowercase hexadecimal digits");
+        model.payloads.emplace_back(name, std::move(p));
+      }
+      m.models.push_back(std::move(model));
     }
   }
   if (const json* vj = r.optional_member(j, "volume")) {

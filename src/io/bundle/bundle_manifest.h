@@ -17,6 +17,8 @@ namespace detail {
 
 std::string manifest_to_json(const BundleManifest& m);
 BundleManifest parse_manifest(std::string_view text, const std::string& file, const BundleLimits& limits);
+/// Whether `text` is one JSON object within the manifest's nesting limit (a codec's section).
+bool is_json_object_text(const std::string& text);
 /// Attachment names: 1–128 of [A-Za-z0-9._-], not "." or "..".
 bool is_attachment_name(const std::string& name);
 /// Channel names as stored in map payloads: {"Y"} or {"R","G","B"}.

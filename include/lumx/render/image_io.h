@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// lumx/io/image_io.h — lumx's rendered images as OpenEXR files (linear float, ZIP-compressed scanlines).
+// lumx/render/image_io.h — lumx's rendered images as OpenEXR files (linear float, ZIP-compressed scanlines).
 //
 // Written atomically (lumx/io/atomic_file.h). Reading checks the header against ImageReadLimits before any
 // pixel is allocated, and returns R, G, B, A first in that order when present, then the other channels in

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// src/io/image_io.cpp — OpenEXR image files through the in-memory codec of the bundle payloads.
-#include <lumx/io/image_io.h>
+// src/render/image_io.cpp — OpenEXR image files through the in-memory codec of the bundle payloads.
+#include <lumx/render/image_io.h>
 
 #include <lumx/core/diagnostic.h>
 #include <lumx/io/atomic_file.h>
