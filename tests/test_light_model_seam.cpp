@@ -2,10 +2,11 @@
 // Copyright Contributors to the lumx project.
 // The representation seam (model/light_model.h, model/registry.h): a representation registered here, in
 // the test alone — an isotropic point light — is built from rays, written into a bundle, checked, read
-// back, graded on held-out rays and rendered in a room through the library's generic paths, with no
+// back, graded on held-out rays and (test_light_model_seam_room.cpp) rendered in a room through the library's generic paths, with no
 // library file knowing its type. The APL level and far field pass through the same seam and give the
 // numbers of the APL queries they wrap.
 #include "test_support.h"
+#include "toy_light_model.h"
 
 #include <lumx/apl/builder.h>
 #include <lumx/apl/evaluation.h>
@@ -18,7 +19,6 @@
 #include <lumx/rays/far_field.h>
 #include <lumx/rays/holdout.h>
 #include <lumx/rays/rayset.h>
-#include <lumx/render/room_render.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -31,110 +31,10 @@
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-// ---- the toy representation: one isotropic point light, I = Φ / 4π toward every direction ----
-class IsotropicPoint final : public lumx::LightModel {
- public:
-  IsotropicPoint(const glm::dvec3& p, double flux) : p_(p), flux_(flux) {}
-  const glm::dvec3& position() const { return p_; }
-  double scalar_flux() const { return flux_; }
-
-  std::string type() const override { return "test-isotropic-point"; }
-  std::string description() const override { return "isotropic point light"; }
-  lumx::PhotometricQuantity quantity() const override { return lumx::PhotometricQuantity::photometric; }
-  lumx::ChannelLayout channels() const override { return lumx::ChannelLayout::luminance; }
-  lumx::BoundingSphere bounds() const override {
-    lumx::BoundingSphere b;
-    b.center = p_;
-    return b;
-  }
-  glm::dvec3 flux() const override { return glm::dvec3(flux_); }
-  glm::dvec3 intensity(const glm::dvec3&) const override { return glm::dvec3(flux_ / (4 * kPi)); }
-  glm::dvec3 irradiance(const glm::dvec3& x, const glm::dvec3& n, const lumx::Visibility* v) const override {
-    const glm::dvec3 to_light = p_ - x;
-    const double r2 = glm::dot(to_light, to_light);
-    const double cosine = glm::dot(n, to_light) / std::sqrt(r2);
-    if (!(cosine > 0) || (v && !v->visible(p_, x))) return glm::dvec3(0.0);
-    return glm::dvec3(flux_ / (4 * kPi) * cosine / r2);
-  }
-  lumx::PositionMeasure position_measure() const override { return lumx::PositionMeasure::discrete; }
-  lumx::ModelEmission sample_emission(const std::array<double, 4>& u) const override {
-    lumx::ModelEmission e;
-    const double z = 1 - 2 * u[1], phi = 2 * kPi * u[2], s = std::sqrt(std::max(0.0, 1 - z * z));
-    e.position = p_;
-    e.direction = {s * std::cos(phi), s * std::sin(phi), z};
-    e.pdf_position = 1;
-    e.pdf_direction = 1 / (4 * kPi);
-    e.flux = glm::dvec3(flux_);
-    return e;
-  }
-  lumx::EmissionDensity emission_pdf(std::size_t element, const glm::dvec3&, const glm::dvec3&) const override {
-    return element == 0 ? lumx::EmissionDensity{1, 1 / (4 * kPi)} : lumx::EmissionDensity{};
-  }
-  std::size_t bytes() const override { return sizeof(*this); }
-
- private:
-  glm::dvec3 p_;
-  double flux_;
-};
-
-lumx::ModelType isotropic_point_type() {
-  lumx::ModelType t;
-  t.name = "test-isotropic-point";
-  t.description = "an isotropic point light (registered by the seam's test)";
-  t.write = [](const lumx::LightModel& m, lumx::ModelPayloadSink& sink) {
-    const auto& point = dynamic_cast<const IsotropicPoint&>(m);
-    const double f = point.scalar_flux();
-    sink.add("flux.f64", std::string(reinterpret_cast<const char*>(&f), sizeof f));
-    nlohmann::json j;
-    j["position"] = {point.position().x, point.position().y, point.position().z};
-    return j.dump();
-  };
-  t.read = [](const std::string& section, const lumx::ModelPayloadSource& payloads,
-              const lumx::ModelLoadOptions&) -> std::unique_ptr<lumx::LightModel> {
-    const nlohmann::json j = nlohmann::json::parse(section);
-    const auto p = j.find("position");
-    if (p == j.end() || !p->is_array() || p->size() != 3)
-      lumx::throw_at_field(payloads.where(), "section/position", "must be three numbers");
-    if (payloads.size("flux.f64") != sizeof(double))
-      lumx::throw_at_field(payloads.where(), "payloads/flux.f64", "must be 8 bytes");
-    const std::string bytes = payloads.read("flux.f64");
-    double f = 0;
-    std::memcpy(&f, bytes.data(), sizeof f);
-    if (!(f >= 0) || !std::isfinite(f)) lumx::throw_at_field(payloads.where(), "payloads/flux.f64", "not a finite flux");
-    return std::make_unique<IsotropicPoint>(glm::dvec3((*p)[0].get<double>(), (*p)[1].get<double>(), (*p)[2].get<double>()), f);
-  };
-  // Φ = Σ ray flux; the point is the flux-weighted mean of the start points.
-  t.build = [](lumx::RaySource& rays, const lumx::ModelBuildOptions&) -> std::unique_ptr<lumx::LightModel> {
-    lumx::RayChunk c;
-    double f = 0;
-    glm::dvec3 m(0.0);
-    while (rays.next(c, 1 << 14))
-      for (std::size_t i = 0; i < c.size(); ++i) f += c.flux[i], m += double(c.flux[i]) * glm::dvec3(c.position(i));
-    return std::make_unique<IsotropicPoint>(f > 0 ? m / f : m, f);
-  };
-  return t;
-}
-
-const lumx::ModelRegistration kIsotropicPoint{isotropic_point_type()};
-
-// An isotropic point source at `centre` of total flux `flux`: rays start 1 cm out along their direction
-// (a recording sphere, as a goniophotometer's rays do), so their start points are not all one point.
-lumx::MemoryRaySource isotropic_rays(const glm::dvec3& centre, double flux, std::size_t n, std::uint32_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-  lumx::RayChunk c;
-  c.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double z = 1 - 2 * u01(rng), phi = 2 * kPi * u01(rng), s = std::sqrt(std::max(0.0, 1 - z * z));
-    const glm::dvec3 d(s * std::cos(phi), s * std::sin(phi), z);
-    c.push_back(glm::vec3(centre + 0.01 * d), glm::vec3(d), float(flux / double(n)));
-  }
-  lumx::RaysetInfo info;
-  info.file = "isotropic";
-  return lumx::MemoryRaySource(std::move(c), std::move(info));
-}
+using lumx_test::IsotropicPoint;
+using lumx_test::isotropic_point_type;
+using lumx_test::isotropic_rays;
+using lumx_test::kPi;
 
 std::shared_ptr<lumx::AplSet> apl_set_of(lumx::RaySource& rays) {
   lumx::AplBuildOptions o;
@@ -303,54 +203,6 @@ TEST(LightModelSeam, TheToyIsGradedOnHeldOutRaysInBothDirections) {
     // (two standard errors of ε̂² at σ 3.6 % over 128 patches: u ≈ 2·0.08·σ/√128 ≈ 5·10⁻⁴ → ±0.6 points).
     EXPECT_NEAR(s.noise_removed, 0.08, 0.015) << "d " << s.relative_distance;
   }
-}
-
-// A box below the light: every texel of the room lit through ModelRoomIlluminance gets the toy's exact
-// E = I cosθ / r², or 0 where the box stands between (decided here by a slab test, not by the renderer).
-TEST(LightModelSeam, TheToyLightsARoomThroughTheGenericIlluminance) {
-  lumx::render::Room room;
-  room.luminaire_position_m = {1.5, 1.4, 1.6};
-  room.texel_size_m = 0.1;
-  const lumx::render::Box box{{1.2, 1.1, 0.0}, {1.8, 1.7, 0.7}};
-  room.occluders.push_back(box);
-  const lumx::render::RoomScene scene(room);
-  const IsotropicPoint light(glm::dvec3(0.0), kFlux);  // at the bundle frame's origin
-  const lumx::render::ModelRoomIlluminance lit(light, room.luminaire_position_m, scene);
-  const lumx::render::SurfaceMaps maps = lumx::render::illuminance_maps(scene, lit, 2);
-  const glm::dvec3 p = room.luminaire_position_m;
-  std::size_t shadowed = 0, compared = 0;
-  for (std::size_t s = 0; s < scene.surfaces().size(); ++s) {
-    const lumx::render::RoomSurface& surface = scene.surfaces()[s];
-    for (int iv = 0; iv < surface.texels_v; ++iv)
-      for (int iu = 0; iu < surface.texels_u; ++iu) {
-        const glm::dvec2 uv = surface.texel_centre(iu, iv);
-        const glm::dvec3 x = surface.point(uv.x, uv.y);
-        // Slab test of the open segment p → x against the box, with the entry and exit parameters.
-        double t0 = 1e-6, t1 = 1 - 1e-6;
-        for (int a = 0; a < 3; ++a) {
-          const double d = x[a] - p[a];
-          if (std::abs(d) < 1e-15) {
-            if (p[a] < box.lo[a] || p[a] > box.hi[a]) t0 = 2;
-            continue;
-          }
-          double ta = (box.lo[a] - p[a]) / d, tb = (box.hi[a] - p[a]) / d;
-          if (ta > tb) std::swap(ta, tb);
-          t0 = std::max(t0, ta), t1 = std::min(t1, tb);
-        }
-        const double to_light_len = glm::length(p - x);
-        // Skip texels whose segment grazes the box (within 1 mm) or lies on it: their verdict is rounding.
-        if (std::abs(t1 - t0) * to_light_len < 1e-3) continue;
-        const bool blocked = t0 < t1;
-        const double cosine = glm::dot(surface.normal, p - x) / to_light_len;
-        const double exact = blocked || cosine <= 0 ? 0.0 : kFlux / (4 * kPi) * cosine / (to_light_len * to_light_len);
-        const double got = maps[s][std::size_t(iv) * std::size_t(surface.texels_u) + std::size_t(iu)];
-        ASSERT_NEAR(got, exact, 1e-9 * kFlux) << surface.name << " " << iu << "," << iv;
-        shadowed += blocked && cosine > 0;
-        ++compared;
-      }
-  }
-  EXPECT_GT(shadowed, 20u);  // the box's shadow on the floor is seen
-  EXPECT_GT(compared, 1000u);
 }
 
 // The APL level through the seam gives the APL queries' numbers bit for bit, and its emission samples carry

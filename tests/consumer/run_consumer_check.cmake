@@ -8,7 +8,10 @@
 #     libxml2 (the static core's private TM-33 dependency, found through lumx-core.cmake);
 #  3. builds tests/consumer/bake (COMPONENTS bake) and runs it;
 #  4. asks for an unknown component and for each component this installation lacks: configuring must
-#     fail with a message naming it.
+#     fail with a message naming it;
+#  5. installs the core component alone into a second prefix and compiles every header it holds on its own
+#     against it (tests/consumer/headers), then does the same for every header of the whole installation
+#     with every component it has.
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR}/scratch)
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${LUMX_BINARY_DIR} --prefix ${WORK_DIR}/prefix
@@ -61,7 +64,14 @@ if(libs_lower MATCHES "(${forbidden})")
 endif()
 message(STATUS "core consumer: link line and shared libraries free of ${forbidden}")
 
+file(READ ${WORK_DIR}/prefix/${INSTALL_LIBDIR}/cmake/lumx/lumxConfig.cmake config)
+set(has_bake OFF)
+if(config MATCHES "lumx_installed_components core bake")
+  set(has_bake ON)
+endif()
+
 # 3. The bake consumer (COMPONENTS bake): traces a luminaire built in code.
+if(has_bake)
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR}/bake -B ${WORK_DIR}/bake -G "Unix Makefiles"
                         -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix "-DCMAKE_CXX_FLAGS=${CONSUMER_FLAGS}"
                         "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_FLAGS}" RESULT_VARIABLE rc)
@@ -78,10 +88,11 @@ if(rc)
   message(FATAL_ERROR "the bake consumer failed (${rc})")
 endif()
 
+endif()
+
 # 4. Components the installation does not have.
-file(READ ${WORK_DIR}/prefix/${INSTALL_LIBDIR}/cmake/lumx/lumxConfig.cmake config)
 set(absent nonesuch)
-if(NOT config MATCHES "lumx_installed_components core bake")
+if(NOT has_bake)
   list(APPEND absent bake)
 endif()
 foreach(component IN LISTS absent)
@@ -96,4 +107,37 @@ foreach(component IN LISTS absent)
     message(FATAL_ERROR "find_package(lumx COMPONENTS ${component}) failed without naming the component:\n${out}${err}")
   endif()
   message(STATUS "COMPONENTS ${component}: refused, naming it")
+endforeach()
+
+# 5. Every installed header on its own: of a core-only installation, then of the whole one.
+execute_process(COMMAND ${CMAKE_COMMAND} --install ${LUMX_BINARY_DIR} --component core --prefix ${WORK_DIR}/core_prefix
+                RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "installing the core component alone failed (${rc})")
+endif()
+set(header_checks "core_prefix|core")
+if(has_bake)
+  list(APPEND header_checks "prefix|core,bake")
+endif()
+foreach(check IN LISTS header_checks)
+  string(REPLACE "|" ";" parts "${check}")
+  list(GET parts 0 prefix)
+  list(GET parts 1 components)
+  string(REPLACE "," ";" components "${components}")
+  string(MAKE_C_IDENTIFIER "${prefix}" tag)
+  execute_process(COMMAND ${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR}/headers -B ${WORK_DIR}/headers_${tag} -G "Unix Makefiles"
+                          -DCMAKE_PREFIX_PATH=${WORK_DIR}/${prefix} -DHEADER_ROOT=${WORK_DIR}/${prefix}/include
+                          -DLUMX_PREFIX=${WORK_DIR}/${prefix} "-DLUMX_COMPONENTS=${components}"
+                          "-DCMAKE_CXX_FLAGS=${CONSUMER_FLAGS}"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc)
+    message(FATAL_ERROR "configuring the header check of ${prefix} (COMPONENTS ${components}) failed:\n${out}${err}")
+  endif()
+  string(REGEX MATCH "installed headers compiled on their own: [0-9]+" count "${out}")
+  execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/headers_${tag} -j 2
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc)
+    message(FATAL_ERROR "an installed header of ${prefix} (COMPONENTS ${components}) does not compile on its own:\n${out}${err}")
+  endif()
+  message(STATUS "${prefix} (COMPONENTS ${components}): ${count}")
 endforeach()
