@@ -74,7 +74,7 @@ namespace detail {
 ModelType apl_model_type() {
   ModelType t;
   t.name = "apl";
-  t.description = "APL level: anisotropic point lights on equal-area sphere maps (000 §4)";
+  t.description = "APL level: anisotropic point lights on equal-area sphere maps";
   // Stored by the bundle itself (its "levels", io/bundle_io.h): no section codec.
   t.build = [](RaySource& rays, const ModelBuildOptions& o) -> std::unique_ptr<LightModel> {
     AplBuildOptions b;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// lumx/model/apl_model.h — one level of an APL set as a LightModel (registered as "apl"; dissertation 000
-// §4.3–4.5): irradiance and intensity as apl/evaluation.h computes them, emission sampling as
+// lumx/model/apl_model.h — one level of an APL set as a LightModel (registered as "apl";
+// [VelazquezArmendariz2014] §4.3–4.5, docs/references.md): irradiance and intensity as apl/evaluation.h computes them, emission sampling as
 // apl/sampling.h's AplEmissionSampler draws it (an APL by flux, a direction by its dilated map), so the
 // seam returns the same numbers as the APL queries it wraps.
 #pragma once

@@ -7,7 +7,7 @@
 // diameter), each sphere cut into N = 2·R_patch² equal-area patches, E_ref(patch) = Σ Φ / A of the rays
 // whose lines cross it, with the variance of that estimate from the rays themselves. The model is read at
 // each patch's centre (one irradiance() call a patch, normal toward the sphere's centre) and compared by
-// the relative RMSE of 000 eq. 5.1; the reference's noise is removed (ε̂ = √max(0, ε² − σ²)) and ε̂'s
+// the relative RMSE of [VelazquezArmendariz2014] eq. 5.1; the reference's noise is removed (ε̂ = √max(0, ε² − σ²)) and ε̂'s
 // upper bound and resolution are stated as apl/error.h states them. The patch-mean reference is not
 // moved to the patch centres (the APL path's centring needs a pilot of the graded type), so smooth
 // emitters' errors are overstated by the curvature of E within a patch.

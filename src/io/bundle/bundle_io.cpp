@@ -577,8 +577,9 @@ namespace {
 // A model's payloads as its codec reads them: only those it asks for, each size- and checksum-verified.
 class ModelSource final : public ModelPayloadSource {
  public:
-  ModelSource(const BundleModelInfo& info, std::string where, std::function<std::string(const BundlePayload&, const std::string&)> read)
-      : info_(info), where_(std::move(where)), read_(std::move(read)) {}
+  ModelSource(const BundleModelInfo& info, std::size_t index, std::string where,
+              std::function<std::string(const BundlePayload&, const std::string&)> read)
+      : info_(info), pointer_("/models/" + std::to_string(index)), where_(std::move(where)), read_(std::move(read)) {}
   std::vector<std::string> names() const override {
     std::vector<std::string> n;
     for (const auto& [name, p] : info_.payloads) n.push_back(name);
@@ -591,16 +592,16 @@ class ModelSource final : public ModelPayloadSource {
  private:
   std::string field_of(const std::string& name) const {
     for (std::size_t q = 0; q < info_.payloads.size(); ++q)
-      if (info_.payloads[q].first == name) return "/models/" + model_index() + "/payloads/" + std::to_string(q);
-    return "/models/" + model_index() + "/payloads";
+      if (info_.payloads[q].first == name) return pointer_ + "/payloads/" + std::to_string(q);
+    return pointer_ + "/payloads";
   }
-  std::string model_index() const { return where_.substr(where_.rfind('/') + 1); }
   const BundlePayload& find(const std::string& name) const {
     for (const auto& [n, p] : info_.payloads)
       if (n == name) return p;
     throw_at_field(where_, "payloads", "model \"" + info_.name + "\" has no payload \"" + name + "\"");
   }
   const BundleModelInfo& info_;
+  std::string pointer_;  // /models/INDEX
   std::string where_;
   std::function<std::string(const BundlePayload&, const std::string&)> read_;
 };
@@ -616,7 +617,7 @@ std::unique_ptr<LightModel> BundleReader::load_model(std::size_t index, const Mo
   if (!t || !t->read)
     fail(manifest, at + "/type", "no representation is registered as \"" + info.type + "\" in this program");
   // where(): the manifest and the model's pointer, e.g. bundle/manifest.json#/models/0.
-  const ModelSource source(info, manifest + "#" + at,
+  const ModelSource source(info, index, manifest + "#" + at,
                            [this](const BundlePayload& p, const std::string& field) { return read_payload(p, field); });
   std::unique_ptr<LightModel> model;
   try {
