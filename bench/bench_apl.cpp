@@ -19,6 +19,7 @@
 #include <lumx/apl/evaluation.h>
 #include <lumx/apl/apl_set.h>
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/volume/radiance_volume.h>
 #include <lumx/math/spherical_harmonics.h>

@@ -24,6 +24,7 @@
 #include "eval_plot.h"
 
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/apl/evaluation.h>
 #include <lumx/apl/lod.h>
 #include <lumx/io/atomic_file.h>

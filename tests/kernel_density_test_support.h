@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -204,6 +205,43 @@ inline std::vector<double> exact_grid(const WallField& field, int nx, int ny) {
       out[std::size_t(iy) * std::size_t(nx) + std::size_t(ix)] =
           field.illuminance_lx((ix + 0.5) * kWallWidth / nx, (iy + 0.5) * kWallHeight / ny);
   return out;
+}
+
+/// Evaluation points every 5 cm on the 3 m × 2 m wall.
+constexpr int kGridX = 60, kGridY = 40;
+
+/// Per seed, the kGridX × kGridY grid of each reconstruction (row-major, as evaluate_grid).
+struct Study {
+  std::vector<std::vector<double>> adaptive, fixed, histogram;
+};
+
+/// `seeds` draws of n deposits from `field` (seeds first_seed, first_seed + 1, …), each reconstructed three
+/// ways: the default (adaptive) options, the same with sensitivity 0 (one fixed bandwidth h₀), and a
+/// Scott's-rule histogram.
+inline Study run_study(const WallField& field, std::size_t n, int seeds, int first_seed = 1) {
+  using lumx::render::AdaptiveKernelDensity2D;
+  Study s;
+  for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
+    const auto d = draw_deposits(field, n, std::uint64_t(seed));
+    lumx::render::AdaptiveKernelOptions o;
+    s.adaptive.push_back(AdaptiveKernelDensity2D(d, kWallWidth, kWallHeight, o).evaluate_grid(kGridX, kGridY));
+    o.sensitivity = 0.0;
+    s.fixed.push_back(AdaptiveKernelDensity2D(d, kWallWidth, kWallHeight, o).evaluate_grid(kGridX, kGridY));
+    s.histogram.push_back(histogram_grid(d, kGridX, kGridY));
+  }
+  return s;
+}
+
+/// The points a figure is taken over: all, the peak (E > 2 Ē) or the sparse part (E < Ē/2), Ē the mean
+/// of `exact` over every point.
+enum class Region { all, peak, sparse };
+
+inline std::vector<char> region_mask(const std::vector<double>& exact, Region r) {
+  const double mean = std::accumulate(exact.begin(), exact.end(), 0.0) / double(exact.size());
+  std::vector<char> m(exact.size());
+  for (std::size_t p = 0; p < exact.size(); ++p)
+    m[p] = r == Region::all ? 1 : r == Region::peak ? exact[p] > 2.0 * mean : exact[p] < 0.5 * mean;
+  return m;
 }
 
 }  // namespace lumx_test

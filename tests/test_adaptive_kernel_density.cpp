@@ -248,42 +248,12 @@ TEST(AdaptiveKernelDensity, SameResultForOneAndTwoThreadsAndPointsAgreeWithTheGr
 }
 
 // ---- Accuracy against exact fields ------------------------------------------------------------------
-// The bounds below come from 32 seeds (1000–1031) of the same fields, measured as in docs/render.md; the
+// The bounds below come from 32 seeds (1000–1031) of the same fields, measured as in docs/render.md (by
+// studies/study_kernel_density.cpp, with run_study and region_mask of kernel_density_test_support.h); the
 // tests draw other seeds (1, 2, …), so each figure is a fresh estimate whose standard error is the
 // measured sd across seeds / √seeds. A bound is the measured mean + 4 standard errors (a false alarm
 // ~3 · 10⁻⁵), and a comparison between two estimators is asserted only where the measured gap is more
 // than 10 standard errors of the paired difference.
-
-constexpr int kGridX = 60, kGridY = 40;  // evaluation points every 5 cm on the 3 m × 2 m wall
-
-struct Study {
-  std::vector<std::vector<double>> adaptive, fixed, histogram;
-};
-
-/// `seeds` draws of n deposits from `field`, each reconstructed three ways: the default (adaptive) options,
-/// the same with sensitivity 0 (one fixed bandwidth h₀), and a Scott's-rule histogram.
-Study run_study(const WallField& field, std::size_t n, int seeds, int first_seed = 1) {
-  Study s;
-  for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
-    const auto d = draw_deposits(field, n, std::uint64_t(seed));
-    AdaptiveKernelOptions o;
-    s.adaptive.push_back(AdaptiveKernelDensity2D(d, kWallWidth, kWallHeight, o).evaluate_grid(kGridX, kGridY));
-    o.sensitivity = 0.0;
-    s.fixed.push_back(AdaptiveKernelDensity2D(d, kWallWidth, kWallHeight, o).evaluate_grid(kGridX, kGridY));
-    s.histogram.push_back(histogram_grid(d, kGridX, kGridY));
-  }
-  return s;
-}
-
-enum class Region { all, peak, sparse };  // peak: E > 2 Ē, sparse: E < Ē/2
-
-std::vector<char> region_mask(const std::vector<double>& exact, Region r) {
-  const double mean = std::accumulate(exact.begin(), exact.end(), 0.0) / double(exact.size());
-  std::vector<char> m(exact.size());
-  for (std::size_t p = 0; p < exact.size(); ++p)
-    m[p] = r == Region::all ? 1 : r == Region::peak ? exact[p] > 2.0 * mean : exact[p] < 0.5 * mean;
-  return m;
-}
 
 /// Mean over seeds of the per-seed relative RMSE (its standard error is sd/√seeds).
 double mean_rmse(const ErrorFigures& f) {
@@ -405,48 +375,6 @@ TEST(AdaptiveKernelDensityAccuracy, NarrowSpotKeepsItsPeak) {
       EXPECT_LT(adaptive, 0.5 * mean_rmse(error_figures(s->fixed, exact, *m)));
       EXPECT_LT(adaptive, 0.5 * mean_rmse(error_figures(s->histogram, exact, *m)));
     }
-}
-
-// The figures of docs/render.md (32 seeds, 1000–1031), printed, and checked against the whole-wall RMSE the
-// bounds above were derived from (to their 4 digits). Off by default (about a minute):
-//   build/tests/lumx_tests --gtest_also_run_disabled_tests --gtest_filter='*FiguresOf32Seeds'
-TEST(AdaptiveKernelDensityAccuracy, DISABLED_FiguresOf32Seeds) {
-  const int seeds = 32;
-  const std::vector<std::vector<double>> documented = {{0.0789, 0.0361}, {0.1310, 0.0613}, {0.1556, 0.1075}, {0.3263, 0.1188}};
-  int field_index = 0;
-  for (const WallField& field : {uniform_field(), point_source_field(), shadow_edge_field(), spot_field()}) {
-    int n_index = 0;
-    const auto exact = exact_grid(field, kGridX, kGridY);
-    for (const std::size_t n : {std::size_t(10000), std::size_t(100000)}) {
-      const Study s = run_study(field, n, seeds, 1000);
-      for (const Region r : {Region::all, Region::peak, Region::sparse}) {
-        const auto mask = region_mask(exact, r);
-        if (std::find(mask.begin(), mask.end(), 1) == mask.end()) continue;
-        const ErrorFigures a = error_figures(s.adaptive, exact, mask), f = error_figures(s.fixed, exact, mask),
-                           h = error_figures(s.histogram, exact, mask);
-        if (r == Region::all) {
-          EXPECT_NEAR(a.relative_rmse, documented[std::size_t(field_index)][std::size_t(n_index)], 5e-5) << field.name << " " << n;
-        }
-        double gap = 0.0, gap2 = 0.0;
-        for (int k = 0; k < seeds; ++k) {
-          const double d = a.per_seed_rmse[std::size_t(k)] - f.per_seed_rmse[std::size_t(k)];
-          gap += d / seeds;
-          gap2 += d * d / seeds;
-        }
-        const auto line = [](const char* name, const ErrorFigures& e) {
-          std::printf(" | %s bias %.4f sd %.4f rmse %.4f (seed sd %.4f)", name, e.relative_bias, e.relative_sd,
-                      e.relative_rmse, e.rmse_standard_error * std::sqrt(32.0));
-        };
-        std::printf("%s N=%zu %s", field.name.c_str(), n, r == Region::all ? "all" : r == Region::peak ? "peak" : "sparse");
-        line("adaptive", a);
-        line("fixed", f);
-        line("histogram", h);
-        std::printf(" | adaptive-fixed %.4f (sd %.4f)\n", gap, std::sqrt(std::max(0.0, gap2 - gap * gap) * seeds / (seeds - 1)));
-      }
-      ++n_index;
-    }
-    ++field_index;
-  }
 }
 
 }  // namespace

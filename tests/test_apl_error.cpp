@@ -7,6 +7,7 @@
 // through a bundle.
 #include <lumx/apl/builder.h>
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/apl/lod.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/rayset_io.h>
@@ -15,6 +16,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "apl/error_detail.h"
 #include "rayset_test_support.h"
 
 #include <filesystem>

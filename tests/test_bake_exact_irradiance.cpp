@@ -17,6 +17,7 @@
 
 #include <lumx/apl/builder.h>
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/apl/evaluation.h>
 #include <lumx/bake/bake.h>
 #include <lumx/bake/gltf_writer.h>

@@ -5,6 +5,7 @@
 // library's (whatever the thread count), the bundle's own rays regraded by rebuilding from half.
 #include <lumx/apl/builder.h>
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/io/photometry_io.h>
 #include <lumx/io/rayset_io.h>

@@ -5,6 +5,7 @@
 // evaluation, sampling and the bundle, and the bundle's refusals of bad masks.
 #include <lumx/apl/builder.h>
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/apl/evaluation.h>
 #include <lumx/apl/sampling.h>
 #include <lumx/io/bundle_io.h>
@@ -13,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analytic_emitters.h"
+#include "apl/error_detail.h"
 #include "test_support.h"
 
 #include <algorithm>

@@ -3,6 +3,7 @@
 // The von Mises–Fisher smoothing of sphere maps (math/sphere_map_kernel.h) and its use by the held-out fit
 // (apl/error.h: fitted_level, kernel_peak_change).
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/math/sphere_map_kernel.h>
 
 #include <gtest/gtest.h>

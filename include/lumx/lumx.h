@@ -42,6 +42,7 @@
 #include <lumx/apl/builder.h>
 #include <lumx/apl/clustering.h>
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/apl/evaluation.h>
 #include <lumx/apl/far_field.h>
 #include <lumx/apl/lod.h>

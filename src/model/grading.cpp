@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
+#include "apl/error_detail.h"
 #include <lumx/apl/error.h>
 #include <lumx/model/grading.h>
 #include <lumx/rays/holdout.h>

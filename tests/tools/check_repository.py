@@ -12,7 +12,9 @@
 3. Module order: docs/architecture.md states it on one line, "Module order (...): a → b → ...", and
    every public header of include/lumx/M/ and every file of src/M/ includes (as <lumx/N/...> or "N/...")
    only modules N that come before M or M itself, so the include graph has no cycle.
-4. Third-party data: no tracked file has the same bytes as a file under SHARED_DIR/data (real-world data is
+4. Public headers stay declarations first: none over 800 lines (MAX_HEADER_LINES), and no function body
+   that is not a template's over 60 lines (MAX_INLINE_BODY_LINES) in one; the engine lives in src/.
+5. Third-party data: no tracked file has the same bytes as a file under SHARED_DIR/data (real-world data is
    read there in place, never committed). Without SHARED_DIR the check is reported as skipped, except
    under CI (CI=true), which always has it.
 Prints one line per finding and exits 1 if there is any.
@@ -54,6 +56,51 @@ def sha256(path):
         for block in iter(lambda: f.read(1 << 20), b''):
             h.update(block)
     return h.hexdigest()
+
+
+MAX_HEADER_LINES = 800
+MAX_INLINE_BODY_LINES = 60
+CONTROL = re.compile(r'\b(if|for|while|switch|catch|return|else|do)\s*(\(|$)')
+FUNCTION_HEAD = re.compile(r'\)\s*(const|noexcept|override|final|mutable|&|->[^;{}()]*|\s)*$'
+                           r'|\)\s*:\s*[\s\S]*\)\s*$')  # a signature, or a constructor's initialiser list
+
+
+def code_only(text):
+    """The text with comments, string and character literals blanked, line breaks kept."""
+    out = re.sub(r'/\*[\s\S]*?\*/', lambda m: re.sub(r'[^\n]', ' ', m.group()), text)
+    out = re.sub(r'R"([^(]*)\([\s\S]*?\)\1"', lambda m: re.sub(r'[^\n]', ' ', m.group()), out)
+    out = re.sub(r'"(\\.|[^"\\\n])*"', '""', out)
+    out = re.sub(r"'(\\.|[^'\\\n])+'", "' '", out)
+    return re.sub(r'//[^\n]*', '', out)
+
+
+def long_inline_bodies(text):
+    """(line, lines) of every function body outside any other function, not a template's, over the limit."""
+    code = code_only(text)
+    found = []
+    stack = []  # per open brace: (kind, template, start line); kind 'function' or 'block'
+    last = 0  # where the current head starts: after the last ';', '{' or '}'
+    line = 1
+    for i, c in enumerate(code):
+        if c == '\n':
+            line += 1
+        elif c == '{':
+            head = code[last:i].strip()
+            inside_function = any(k == 'function' for k, _, _ in stack)
+            is_function = (not inside_function and FUNCTION_HEAD.search(head) is not None
+                           and not CONTROL.search(head.split('\n')[-1].strip()) and '](' not in head.replace(' ', ''))
+            template = bool(re.search(r'\btemplate\s*<', head)) or any(t for _, t, _ in stack)
+            stack.append(('function' if is_function else 'block', template, line))
+            last = i + 1
+        elif c == '}':
+            if stack:
+                kind, template, start = stack.pop()
+                if kind == 'function' and not template and line - start - 1 > MAX_INLINE_BODY_LINES:
+                    found.append((start, line - start - 1))
+            last = i + 1
+        elif c == ';':
+            last = i + 1
+    return found
 
 
 def main():
@@ -125,7 +172,19 @@ def main():
                         if d in rank and rank[d] > rank[m]:
                             findings.append(f'{f}:{n}: module order: {m} includes {d}, which comes after it')
 
-    # 4. Third-party data.
+    # 4. Public headers: declarations first.
+    for f in files:
+        if f.startswith('include/lumx/') and f.endswith('.h'):
+            with open(os.path.join(root, f), encoding='utf-8', errors='replace') as fh:
+                text = fh.read()
+            lines = text.count('\n')
+            if lines > MAX_HEADER_LINES:
+                findings.append(f'{f}: header size: {lines} lines, over {MAX_HEADER_LINES} (move the engine to src/)')
+            for start, n in long_inline_bodies(text):
+                findings.append(f'{f}:{start}: header size: a {n}-line function body, over {MAX_INLINE_BODY_LINES} '
+                                '(define it in src/)')
+
+    # 5. Third-party data.
     data = os.path.join(shared, 'data') if shared else ''
     if data and os.path.isdir(data):
         theirs = {}

@@ -12,6 +12,7 @@
 #include <lumx/model/registry.h>
 #include <lumx/apl/builder.h>
 #include <lumx/apl/error.h>
+#include <lumx/apl/map_fit.h>
 #include <lumx/io/bundle_io.h>
 #include <lumx/photometry/far_field_grid.h>
 #include <lumx/rays/rayset.h>
