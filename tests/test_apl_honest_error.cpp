@@ -93,12 +93,6 @@ class HonestErrorSuite : public ::testing::TestWithParam<int> {};
 // Printed per level and distance: the error against the exact irradiance at the patch centres / against
 // the exact patch means / the held-out estimate with the noise removed ('<': an upper bound).
 TEST_P(HonestErrorSuite, HeldOutEstimateAgreesWithTheTrueError) {
-#if defined(__SANITIZE_ADDRESS__)
-  // An accuracy check, about ten times slower under the sanitizers (the box with holes: 137 s from 200 k
-  // rays); the held-out fit and grading it runs are run there by CliBuild.EvalOnTheBundlesOwnRays…,
-  // BakePasses.StopsAsSoonAs… and the ResolutionFit tests.
-  GTEST_SKIP() << "release build only";
-#endif
   // 7: the box with holes as clustered APLs (point sources off), on the rays of 4.
   const bool clustered_box = GetParam() == 7;
   const int emitter = clustered_box ? 4 : GetParam() % 5;
@@ -184,9 +178,6 @@ INSTANTIATE_TEST_SUITE_P(Emitters, HonestErrorSuite, ::testing::Range(0, 8));
 class ShippedSetSuite : public ::testing::TestWithParam<int> {};
 
 TEST_P(ShippedSetSuite, AgainstExactIrradiance) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "release build only (as the held-out suite)";
-#endif
   const std::unique_ptr<AnalyticEmitter> em = suite_emitter(GetParam());
   auto rays = em->source(kSuiteRays, 11 + std::uint64_t(GetParam()));
   AplBuildOptions bo;
@@ -482,9 +473,6 @@ TEST(FitReference, ThePilotsShapeMovesPatchMeansToPatchCentres) {
 // it, an upper bound of 8.8-12.0 % at five of those spheres). About 20 s. The same over 20 seeds:
 // studies/study_pinhole_box.cpp, masked-estimate.
 TEST(PinholeBoxStudy, TheUpperBoundHoldsABorderNoMaskResolves) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "release build only (as the held-out suite)";
-#endif
   std::vector<MaskedLevelEstimate> estimates;
   for (const std::uint64_t seed : {15, 16, 18, 19, 23}) {
     estimates.push_back(masked_level_estimate(seed));

@@ -23,7 +23,7 @@ string(CONCAT LUMX_TIER_ACCURACY
   ":SphereMapHarmonics.ShrunkEstimate*:FitReference.*:SphereMapKernel.NoiseFreeSpotsShowWhatTexelMapsCanDo"
   ":AplBuilder.ClustersByLineOnlyWhenTheLinesMeet:AplBuilder.ConvergencePlacementFindsAnEnclosedEmitter"
   ":CliBuild.StoresAndPrintsHeldOutTablesTheLibraryReproduces"
-  ":AplErrorLevels.LevelZeroFarAwayIsNearTheNoiseFloorWithTheBuilderRule")
+  ":AplErrorLevels.LevelZeroFarAwayIsNearTheNoiseFloorWithTheBuilderRule:PinholeBoxStudy.*")
 
 string(CONCAT LUMX_TIER_INTEGRATION
   "Cli*.*:Sample*.*:Bake*.*:RenderRoom.*:RenderAppearance.*:Gldf.*:LightModelSeam.*Room*")

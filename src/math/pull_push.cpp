@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Copyright Contributors to the lumx project.
-// pull_push (math/pull_push.h): seed 002 §5's pull of sums and bilateral push, then the result rescaled to
+// pull_push (math/pull_push.h): [Krosl2017] §5's pull of sums and bilateral push, then the result rescaled to
 // the histogram's flux.
 #include <lumx/math/pull_push.h>
 

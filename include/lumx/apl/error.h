@@ -15,7 +15,7 @@
 //   - Reference. Every ray (start p, direction ω, flux Φ) is followed to where it leaves each sphere, and
 //     Φ is added to the patch that contains the exit point's direction from c. The reference irradiance of
 //     patch i is E_ref(i) = Σ Φ / A (lx for lm, W/m² for W): flux through the patch per unit area, the
-//     histogram estimate of irradiance on the sphere (000 §5.3).
+//     histogram estimate of irradiance on the sphere ([VelazquezArmendariz2014] §5.3).
 //       · Rays start inside or on the sphere for d ≥ 0.5 when the bounds hold every start point. A ray
 //         starting outside is counted (`started_outside`); it contributes at its exit point if its line
 //         crosses the sphere ahead of it, and is otherwise counted in `missed`.
@@ -47,11 +47,12 @@
 //     E = I(ω)·max(0, −n·ω)/r².
 //
 // Metrics, per (level, d), over the N patches (E_ref = reference, E = model):
-//   relative RMSE (000 eq. 5.1)   ε = √(Σ_i (E_ref(i) − E(i))² / N) / (Σ_i E_ref(i) / N)
+//   relative RMSE ([VelazquezArmendariz2014] eq. 5.1)
+//                                 ε = √(Σ_i (E_ref(i) − E(i))² / N) / (Σ_i E_ref(i) / N)
 //   normalised distributions      p_i = E_ref(i) / Σ_j E_ref(j),  q_i = E(i) / Σ_j E(j)   (Σ p = Σ q = 1;
 //                                 equal-area patches make these probabilities of a patch receiving light)
-//   l² distance (001 §6)          D_l²(p, q) = √(Σ_i (p_i − q_i)²)                          ∈ [0, √2]
-//   Hellinger distance (001 §6)   D_H(p, q) = √(½ Σ_i (√p_i − √q_i)²)                      ∈ [0, 1]
+//   l² distance ([Mas2008] §6)   D_l²(p, q) = √(Σ_i (p_i − q_i)²)                          ∈ [0, √2]
+//   Hellinger distance ([Mas2008] §6) D_H(p, q) = √(½ Σ_i (√p_i − √q_i)²)                      ∈ [0, 1]
 //   ε measures absolute (flux) errors relative to the mean; D_l² and D_H only the shape of the pattern.
 //   A metric is NaN when it is undefined: no patch, or a distribution with no light (Σ = 0).
 //
@@ -107,8 +108,8 @@ struct IrradianceErrors {
   /// u: the standard error of ε̂² (of ε² − σ², from the reference's noise; header comment).
   double noise_removed_standard_error = NAN;
   bool resolved = false;   ///< ε̂² > 2u: the error stands out of the reference's noise
-  double l2 = NAN;         ///< l² distance of the normalised distributions (001 §6)
-  double hellinger = NAN;  ///< Hellinger distance of the normalised distributions (001 §6)
+  double l2 = NAN;         ///< l² distance of the normalised distributions ([Mas2008] §6)
+  double hellinger = NAN;  ///< Hellinger distance of the normalised distributions ([Mas2008] §6)
 };
 
 /// Relative RMSE (eq. 5.1), l² and Hellinger distances of `model` against `reference`, patch by patch.
